@@ -1,0 +1,205 @@
+//! Micro-BSDFs: what happens when a ray meets a single facet (THEORY.md §4.2–§4.5).
+//!
+//! A facet interaction returns one or two weighted branches. The walk decides how to follow
+//! two branches (split both, or choose one; §4.6); weights below one are absorption. A path
+//! carries `C` channel weights (1 or 3): geometry is shared, Fresnel and albedo act per channel.
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+use rand::Rng;
+
+use crate::fresnel;
+use crate::random::open01;
+
+/// Which side of the heightfield a ray is on (§4.3): outside (above) or inside (below, only
+/// for dielectrics).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Side {
+    Outside,
+    Inside,
+}
+
+impl Side {
+    pub fn other(self) -> Self {
+        match self {
+            Side::Outside => Side::Inside,
+            Side::Inside => Side::Outside,
+        }
+    }
+}
+
+/// One outcome of a facet interaction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Branch<const C: usize> {
+    /// New travel direction (unit).
+    pub dir: DVec3,
+    /// Per-channel factor on the path weight.
+    pub weight: [f64; C],
+    /// Whether the ray passes to the other side of the interface (refraction).
+    pub crosses: bool,
+}
+
+/// The outcomes of a facet interaction (§4.6).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Interaction<const C: usize> {
+    /// A single outcome; its weight is the facet's albedo for this incidence.
+    One(Branch<C>),
+    /// Two exclusive outcomes (reflect or refract; specular or diffuse exit).
+    Two(Branch<C>, Branch<C>),
+}
+
+/// A facet material: the micro-BSDF of one facet.
+pub trait Facet<const C: usize>: Send + Sync {
+    /// The interaction of light arriving from `w` (pointing away from the facet) with a facet
+    /// of normal `m`, `w·m > 0`, on `side` of the surface.
+    fn interact<R: Rng + ?Sized>(&self, w: DVec3, m: DVec3, side: Side, rng: &mut R) -> Interaction<C>;
+}
+
+/// Mirror reflection of `w` about `m`: `2 (w·m) m - w`.
+#[inline]
+pub fn reflect(w: DVec3, m: DVec3) -> DVec3 {
+    2.0 * w.dot(m) * m - w
+}
+
+/// Refraction of `w` through a facet `m` with relative index `eta = eta_t / eta_i` (§4.3):
+/// `(c/eta - sqrt(1 - (1 - c^2)/eta^2)) m - w/eta`; `None` under total internal reflection.
+#[inline]
+pub fn refract(w: DVec3, m: DVec3, eta: f64) -> Option<DVec3> {
+    let c = w.dot(m);
+    let k = 1.0 - (1.0 - c * c) / (eta * eta);
+    if k <= 0.0 {
+        return None;
+    }
+    Some(((c / eta - k.sqrt()) * m - w / eta).normalize())
+}
+
+/// Fresnel law of a conductor facet (§4.2), per channel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ConductorFresnel<const C: usize> {
+    /// `F = 1`: the white furnace.
+    None,
+    /// Schlick's approximation from normal-incidence reflectance F0.
+    Schlick { f0: [f64; C] },
+    /// Exact Fresnel of the complex relative index `eta + i k`.
+    Exact { eta: [f64; C], k: [f64; C] },
+}
+
+/// Mirror facets that reflect `F` and absorb the rest (§4.2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Conductor<const C: usize> {
+    pub fresnel: ConductorFresnel<C>,
+}
+
+impl<const C: usize> Facet<C> for Conductor<C> {
+    fn interact<R: Rng + ?Sized>(&self, w: DVec3, m: DVec3, _side: Side, _rng: &mut R) -> Interaction<C> {
+        let c = w.dot(m);
+        let weight = match self.fresnel {
+            ConductorFresnel::None => [1.0; C],
+            ConductorFresnel::Schlick { f0 } => f0.map(|f0| fresnel::schlick(f0, c)),
+            ConductorFresnel::Exact { eta, k } => std::array::from_fn(|i| fresnel::conductor(eta[i], k[i], c)),
+        };
+        Interaction::One(Branch { dir: reflect(w, m), weight, crosses: false })
+    }
+}
+
+/// Smooth dielectric facets of relative index `eta = n_inside / n_outside` (§4.3): reflect
+/// with the exact Fresnel probability, refract otherwise; no absorption.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dielectric {
+    pub eta: f64,
+}
+
+impl<const C: usize> Facet<C> for Dielectric {
+    fn interact<R: Rng + ?Sized>(&self, w: DVec3, m: DVec3, side: Side, _rng: &mut R) -> Interaction<C> {
+        let eta = match side {
+            Side::Outside => self.eta,
+            Side::Inside => 1.0 / self.eta,
+        };
+        let reflected = Branch { dir: reflect(w, m), weight: [1.0; C], crosses: false };
+        let f = fresnel::dielectric(eta, w.dot(m));
+        match refract(w, m, eta) {
+            Some(dir) if f < 1.0 => Interaction::Two(
+                Branch { weight: [f; C], ..reflected },
+                Branch { dir, weight: [1.0 - f; C], crosses: true },
+            ),
+            _ => Interaction::One(reflected),
+        }
+    }
+}
+
+/// Lambertian facets of albedo `rho` (§4.4): cosine-distributed exit about `m`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lambertian<const C: usize> {
+    pub albedo: [f64; C],
+}
+
+impl<const C: usize> Facet<C> for Lambertian<C> {
+    fn interact<R: Rng + ?Sized>(&self, _w: DVec3, m: DVec3, _side: Side, rng: &mut R) -> Interaction<C> {
+        let u = open01(rng);
+        let cos_theta = (1.0 - u).sqrt();
+        let dir = about_normal(m, cos_theta, 2.0 * PI * open01(rng));
+        Interaction::One(Branch { dir, weight: self.albedo, crosses: false })
+    }
+}
+
+/// Hammon 2017's facet (§4.5): Schlick-Fresnel mirror reflection, plus a normalized
+/// Fresnel-weighted diffuse exit with density `k (1 - (1 - c)^5) c`, `k = 21 / (20 pi)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hammon<const C: usize> {
+    pub f0: [f64; C],
+    pub albedo: [f64; C],
+}
+
+impl<const C: usize> Facet<C> for Hammon<C> {
+    fn interact<R: Rng + ?Sized>(&self, w: DVec3, m: DVec3, _side: Side, rng: &mut R) -> Interaction<C> {
+        let f = self.f0.map(|f0| fresnel::schlick(f0, w.dot(m)));
+        let specular = Branch { dir: reflect(w, m), weight: f, crosses: false };
+        let cos_theta = hammon_exit_cosine(open01(rng));
+        let dir = about_normal(m, cos_theta, 2.0 * PI * open01(rng));
+        let weight = std::array::from_fn(|i| (1.0 - f[i]) * self.albedo[i]);
+        Interaction::Two(specular, Branch { dir, weight, crosses: false })
+    }
+}
+
+/// The direction at polar angle `acos(cos_theta)` and azimuth `phi` about the unit vector `m`.
+#[inline]
+fn about_normal(m: DVec3, cos_theta: f64, phi: f64) -> DVec3 {
+    let (t, b) = m.any_orthonormal_pair();
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let (s, c) = phi.sin_cos();
+    (sin_theta * c * t + sin_theta * s * b + cos_theta * m).normalize()
+}
+
+/// CDF of the cosine of Hammon's exit direction about the facet normal (§4.5):
+/// `Y(c) = 7/2 c^3 - 21/4 c^4 + 21/5 c^5 - 7/4 c^6 + 3/10 c^7`.
+pub fn hammon_exit_cdf(c: f64) -> f64 {
+    c * c * c * (3.5 + c * (-5.25 + c * (4.2 + c * (-1.75 + c * 0.3))))
+}
+
+/// Solves `Y(c) = u` for the exit cosine (§4.5): Hammon's rational initial guess, then Newton
+/// steps safeguarded by bisection (Newton is slow near `c = 0` where `Y' -> 0`), to full
+/// double precision.
+pub fn hammon_exit_cosine(u: f64) -> f64 {
+    let (u2, u3) = (u * u, u * u * u);
+    let guess = (0.0114813 + 154.4 * u + 13002.4 * u2 + 38295.9 * u3)
+        / (1.0 + 1483.57 * u + 33596.4 * u2 + 16520.2 * u3);
+    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+    let mut c = guess.clamp(0.0, 1.0);
+    for _ in 0..100 {
+        let f = hammon_exit_cdf(c) - u;
+        if f > 0.0 {
+            hi = c;
+        } else {
+            lo = c;
+        }
+        let slope = 2.1 * c * (1.0 - (1.0 - c).powi(5));
+        let newton = c - f / slope;
+        let next = if newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+        if (next - c).abs() <= 1e-15 || hi - lo <= 1e-15 {
+            return next;
+        }
+        c = next;
+    }
+    c
+}

@@ -1,0 +1,28 @@
+//! The statistical Smith microsurface as a random medium.
+//!
+//! A microsurface is composed of independent pieces, each behind a trait where real
+//! alternatives exist (THEORY.md §0–§4):
+//!
+//! * [`ndf`]: the distribution of normals (GGX, Beckmann), its Smith `Lambda`, projected area
+//!   and exact full-sphere visible-normal sampling;
+//! * [`smith`]: which `Lambda` drives the height process (true full-sphere Smith or Hammon's
+//!   symmetric variant);
+//! * [`height`]: the height distribution and the free-flight law in optical depth;
+//! * [`normals`]: how the facet hit by a ray is drawn (visible normals or Hammon's rejection);
+//! * [`fresnel`]: Fresnel reflectances;
+//! * [`facet`]: the micro-BSDF of a single facet (conductor, dielectric, Lambertian, Hammon);
+//! * [`walk`]: the random walk of Heitz et al. 2016 that composes them.
+//!
+//! Everything here is pure physics: no I/O, no threads, no binning.
+
+pub mod facet;
+pub mod fresnel;
+pub mod height;
+pub mod ndf;
+pub mod normals;
+pub mod random;
+pub mod single;
+pub mod smith;
+pub mod walk;
+
+pub use glam::DVec3;

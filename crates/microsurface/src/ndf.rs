@@ -1,0 +1,289 @@
+//! Normal distribution functions: D, Smith Lambda, projected area and visible-normal sampling
+//! (THEORY.md §1 and §3).
+//!
+//! Both NDFs are anisotropic with roughness (alpha_x, alpha_y) and stretch-invariant (§1.1):
+//! every quantity is computed in the stretched configuration of roughness 1 where that is
+//! simpler or more accurate.
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+use rand::Rng;
+use statrs::function::erf::{erf_inv, erfc};
+
+use crate::random::open01;
+
+const SQRT_PI: f64 = 1.772_453_850_905_516;
+
+/// Anisotropic roughness: the slope scales along the tangent axes x and y (§0, §1.2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Roughness {
+    pub x: f64,
+    pub y: f64,
+}
+
+impl Roughness {
+    pub fn isotropic(alpha: f64) -> Self {
+        Self { x: alpha, y: alpha }
+    }
+
+    /// `alpha_x^2 w_x^2 + alpha_y^2 w_y^2`: the squared projected roughness times `1 - w_z^2` (§1.3).
+    #[inline]
+    fn tangential2(self, w: DVec3) -> f64 {
+        let (ax, ay) = (self.x * w.x, self.y * w.y);
+        ax * ax + ay * ay
+    }
+
+    /// The direction in the stretched roughness-1 configuration, `normalize(ax wx, ay wy, wz)` (§1.1).
+    #[inline]
+    pub fn stretch(self, w: DVec3) -> DVec3 {
+        DVec3::new(self.x * w.x, self.y * w.y, w.z).normalize()
+    }
+
+    /// The normal of unit roughness `m'` mapped back to this roughness, `normalize(ax m'x, ay m'y, m'z)` (§1.1).
+    #[inline]
+    pub fn unstretch_normal(self, m: DVec3) -> DVec3 {
+        let n = DVec3::new(self.x * m.x, self.y * m.y, m.z);
+        let len = n.length();
+        if len > 0.0 { n / len } else { DVec3::Z }
+    }
+}
+
+/// A microfacet normal distribution (§1.2): the alternatives are GGX and Beckmann.
+pub trait Ndf: Copy + Send + Sync {
+    fn roughness(&self) -> Roughness;
+
+    /// The distribution of normals D(m) [sr^-1] for `m_z > 0` (§1.2), zero below.
+    fn d(&self, m: DVec3) -> f64;
+
+    /// The true full-sphere Smith Lambda(w) (§1.4): `Lambda(-w) = -1 - Lambda(w)`,
+    /// `>= 0` above the horizon, `<= -1` below, `+inf` for `w_z = +0` and `-inf` for `w_z = -0`.
+    fn lambda(&self, w: DVec3) -> f64;
+
+    /// The projected area A(w) = ∫ D(m) <w·m> dm of the facets facing w, any w (§1.5).
+    fn projected_area(&self, w: DVec3) -> f64;
+
+    /// Draws m from the visible-normal distribution `D_w(m) = <w·m> D(m) / A(w)` (§3.1),
+    /// exactly, for any `w` on the sphere except `-z` (where `A = 0`; then it returns `+z`).
+    fn sample_visible<R: Rng + ?Sized>(&self, w: DVec3, rng: &mut R) -> DVec3;
+
+    /// Slope radius `r = tan(theta_m)` of a normal drawn from `D(m) m_z` in the roughness-1
+    /// configuration, as a function of a uniform `u` (the inverse of [`Ndf::std_slope_cdf`]).
+    fn std_slope_radius(u: f64) -> f64;
+
+    /// Probability that a normal drawn from `D(m) m_z` (roughness 1) has slope radius below `r`.
+    fn std_slope_cdf(r: f64) -> f64;
+}
+
+/// Anisotropic GGX (Trowbridge–Reitz), §1.2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ggx(pub Roughness);
+
+impl Ndf for Ggx {
+    fn roughness(&self) -> Roughness {
+        self.0
+    }
+
+    fn d(&self, m: DVec3) -> f64 {
+        if m.z <= 0.0 {
+            return 0.0;
+        }
+        let Roughness { x: ax, y: ay } = self.0;
+        let (sx, sy) = (m.x / ax, m.y / ay);
+        let k = sx * sx + sy * sy + m.z * m.z;
+        1.0 / (PI * ax * ay * k * k)
+    }
+
+    /// `Lambda = (|A w| - w_z) / (2 w_z)` (§1.4, vector form), rearranged above the horizon
+    /// as `t / (2 w_z (|A w| + w_z))` so that it does not cancel near the zenith.
+    fn lambda(&self, w: DVec3) -> f64 {
+        let t = self.0.tangential2(w);
+        let norm = (t + w.z * w.z).sqrt();
+        if w.z > 0.0 {
+            t / (2.0 * w.z * (norm + w.z))
+        } else {
+            (norm - w.z) / (2.0 * w.z)
+        }
+    }
+
+    /// `A = (w_z + |A w|) / 2` (§1.5), rearranged below the horizon to avoid cancellation.
+    fn projected_area(&self, w: DVec3) -> f64 {
+        let t = self.0.tangential2(w);
+        let norm = (t + w.z * w.z).sqrt();
+        if w.z >= 0.0 {
+            0.5 * (w.z + norm)
+        } else if t > 0.0 {
+            0.5 * t / (norm - w.z)
+        } else {
+            0.0
+        }
+    }
+
+    /// Dupuy & Benyoub 2023 spherical caps (§3.2), exact on the full sphere.
+    fn sample_visible<R: Rng + ?Sized>(&self, w: DVec3, rng: &mut R) -> DVec3 {
+        let ws = self.0.stretch(w);
+        let phi = 2.0 * PI * open01(rng);
+        let z = (1.0 - open01(rng)) * (1.0 + ws.z) - ws.z;
+        let sin_theta = (1.0 - z * z).max(0.0).sqrt();
+        let (s, c) = phi.sin_cos();
+        let h = DVec3::new(sin_theta * c, sin_theta * s, z) + ws;
+        self.0.unstretch_normal(DVec3::new(h.x, h.y, h.z.max(0.0)))
+    }
+
+    /// `cos^2 theta = 1 - u` for roughness 1 ([Ham17], "Intersection normal"), so `tan^2 = u / (1 - u)`.
+    fn std_slope_radius(u: f64) -> f64 {
+        (u / (1.0 - u)).sqrt()
+    }
+
+    fn std_slope_cdf(r: f64) -> f64 {
+        let r2 = r * r;
+        if r2.is_infinite() { 1.0 } else { r2 / (1.0 + r2) }
+    }
+}
+
+/// Anisotropic Beckmann, §1.2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Beckmann(pub Roughness);
+
+/// Beckmann Lambda for `a = w_z / (alpha_i sqrt(1 - w_z^2)) > 0` (§1.4), written with erfc so that
+/// `erf(a) - 1` does not cancel (§10): `Lambda = (e^{-a^2} / (a sqrt(pi)) - erfc(a)) / 2`.
+fn beckmann_lambda_above(a: f64) -> f64 {
+    if a.is_infinite() {
+        return 0.0;
+    }
+    0.5 * ((-a * a).exp() / (a * SQRT_PI) - erfc(a))
+}
+
+impl Beckmann {
+    /// `a = w_z / sqrt(alpha_x^2 w_x^2 + alpha_y^2 w_y^2)` (§1.4), `±inf` at the poles.
+    fn a(&self, w: DVec3) -> f64 {
+        w.z / self.0.tangential2(w).sqrt()
+    }
+}
+
+impl Ndf for Beckmann {
+    fn roughness(&self) -> Roughness {
+        self.0
+    }
+
+    fn d(&self, m: DVec3) -> f64 {
+        if m.z <= 0.0 {
+            return 0.0;
+        }
+        let Roughness { x: ax, y: ay } = self.0;
+        let (sx, sy) = (m.x / (ax * m.z), m.y / (ay * m.z));
+        let mz2 = m.z * m.z;
+        (-(sx * sx + sy * sy)).exp() / (PI * ax * ay * mz2 * mz2)
+    }
+
+    fn lambda(&self, w: DVec3) -> f64 {
+        let a = self.a(w);
+        if a.is_nan() {
+            return f64::NAN;
+        }
+        if w.z == 0.0 {
+            return if w.z.is_sign_positive() { f64::INFINITY } else { f64::NEG_INFINITY };
+        }
+        if a > 0.0 { beckmann_lambda_above(a) } else { -1.0 - beckmann_lambda_above(-a) }
+    }
+
+    /// `A = (1 + Lambda(w)) w_z` above the horizon and `Lambda(-w) |w_z|` below (§1.5, §10).
+    fn projected_area(&self, w: DVec3) -> f64 {
+        let a = self.a(w);
+        if w.z > 0.0 {
+            (1.0 + beckmann_lambda_above(a)) * w.z
+        } else if w.z < 0.0 {
+            beckmann_lambda_above(-a) * -w.z
+        } else {
+            self.0.tangential2(w).sqrt() / (2.0 * SQRT_PI)
+        }
+    }
+
+    /// Exact full-sphere sampler in the stretched frame aligned with w (§3.1): the slope along w
+    /// has density `∝ (mu - x) e^{-x^2}` on `x < mu = cot theta'` and the orthogonal slope is an
+    /// independent normal of variance 1/2.
+    fn sample_visible<R: Rng + ?Sized>(&self, w: DVec3, rng: &mut R) -> DVec3 {
+        let ws = self.0.stretch(w);
+        let sin_theta = ws.x.hypot(ws.y);
+        let (x, cos_phi, sin_phi) = if sin_theta > 0.0 {
+            let mu = ws.z / sin_theta;
+            (visible_slope_beckmann(mu, rng), ws.x / sin_theta, ws.y / sin_theta)
+        } else if ws.z > 0.0 {
+            (erf_inv(2.0 * open01(rng) - 1.0), 1.0, 0.0)
+        } else {
+            return DVec3::Z;
+        };
+        let y = erf_inv(2.0 * open01(rng) - 1.0);
+        let sx = cos_phi * x - sin_phi * y;
+        let sy = sin_phi * x + cos_phi * y;
+        slope_to_normal(self.0.x * sx, self.0.y * sy)
+    }
+
+    /// `tan^2 theta = -ln(1 - u)` for roughness 1.
+    fn std_slope_radius(u: f64) -> f64 {
+        (-(-u).ln_1p()).sqrt()
+    }
+
+    fn std_slope_cdf(r: f64) -> f64 {
+        -(-r * r).exp_m1()
+    }
+}
+
+/// The normal of slope (x, y): `normalize(-x, -y, 1)` (§1.1).
+#[inline]
+pub fn slope_to_normal(x: f64, y: f64) -> DVec3 {
+    DVec3::new(-x, -y, 1.0).normalize()
+}
+
+/// Draws the slope along the view direction from `p(x) ∝ (mu - x) e^{-x^2}`, `x < mu` (any real mu).
+///
+/// For `mu >= -1` the CDF `F(x) = mu sqrt(pi)/2 erfc(-x) + e^{-x^2}/2` is inverted by safeguarded
+/// Newton iteration. Below, `s = mu - x` has density `∝ s e^{-2|mu| s} e^{-s^2}`: a Gamma(2, 2|mu|)
+/// proposal accepted with probability `e^{-s^2}` is exact and avoids the cancellation in `F(mu)`.
+fn visible_slope_beckmann<R: Rng + ?Sized>(mu: f64, rng: &mut R) -> f64 {
+    if mu < -1.0 {
+        let rate = -2.0 * mu;
+        loop {
+            let s = -(open01(rng).ln() + open01(rng).ln()) / rate;
+            if open01(rng) < (-s * s).exp() {
+                return mu - s;
+            }
+        }
+    }
+    let cdf = |x: f64| 0.5 * SQRT_PI * mu * erfc(-x) + 0.5 * (-x * x).exp();
+    let target = open01(rng) * cdf(mu);
+    let (mut lo, mut hi) = (mu.min(0.0) - 1.0, mu);
+    while cdf(lo) > target {
+        lo = 2.0 * lo - 1.0;
+    }
+    let mut x = erf_inv(2.0 * target / cdf(mu) - 1.0).clamp(lo, hi);
+    for _ in 0..100 {
+        let f = cdf(x) - target;
+        if f > 0.0 {
+            hi = x;
+        } else {
+            lo = x;
+        }
+        let slope = (mu - x) * (-x * x).exp();
+        let newton = x - f / slope;
+        let next = if newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+        if (next - x).abs() <= 1e-15 * (1.0 + x.abs()) || hi - lo <= 1e-15 * (1.0 + x.abs()) {
+            return next;
+        }
+        x = next;
+    }
+    x
+}
+
+/// The 1-D marginal of the slope in the vertical plane of a direction with projected roughness
+/// `alpha_i` (§1.3): the integrand of the Smith definition of Lambda (§1.4).
+pub fn ggx_slope_marginal(q: f64, alpha_i: f64) -> f64 {
+    let a2 = alpha_i * alpha_i;
+    a2 / (2.0 * (a2 + q * q).powf(1.5))
+}
+
+/// Beckmann counterpart of [`ggx_slope_marginal`] (§1.3).
+pub fn beckmann_slope_marginal(q: f64, alpha_i: f64) -> f64 {
+    let t = q / alpha_i;
+    (-t * t).exp() / (alpha_i * SQRT_PI)
+}

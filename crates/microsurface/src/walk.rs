@@ -1,0 +1,215 @@
+//! The random walk on the Smith microsurface (Heitz et al. 2016; THEORY.md §4.1, §4.6).
+//!
+//! A photon enters from the light's side at the top of the height support (optical depth 0)
+//! and alternates free flights in optical depth (§2.4) with facet interactions (§4.2–§4.5)
+//! until it escapes. A ray inside a dielectric is walked in the flipped frame (§4.3): its
+//! direction and height are negated, which turns it into an outside problem.
+
+use glam::DVec3;
+use rand::Rng;
+
+use crate::facet::{Branch, Facet, Interaction, Side};
+use crate::height::{Flight, HeightDistribution, fly};
+use crate::ndf::Ndf;
+use crate::normals::Normals;
+use crate::random::{exp1, open01};
+use crate::smith::Smith;
+
+/// A microsurface: an NDF, a height distribution, the Smith variant driving the free flights
+/// and the law of the hit normals. Facet materials plug in independently.
+#[derive(Clone, Copy, Debug)]
+pub struct Microsurface<N, H> {
+    pub ndf: N,
+    pub heights: H,
+    pub smith: Smith,
+    pub normals: Normals,
+}
+
+/// How two-branch interactions and small weights are handled (§4.6).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnergyPolicy {
+    /// Follow both branches while the largest channel weight is at least `threshold`;
+    /// otherwise (or always, when false) choose one branch at random, without bias.
+    pub split: bool,
+    /// Below this largest channel weight a path plays Russian roulette: it survives with
+    /// probability `max(beta) / threshold` and is reweighted by its inverse. 0 disables it.
+    pub threshold: f64,
+}
+
+/// Why a path ended without escaping and without being absorbed (§10, NaN policy).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Loss {
+    /// The ray reached infinite optical depth (`u = 0`), from which nothing escapes (§2.7).
+    Trapped,
+    /// A direction, depth or weight became NaN or infinite.
+    Invalid,
+    /// The path exceeded [`RUNAWAY_ORDER`] facet interactions.
+    Runaway,
+}
+
+/// A safety bound on the number of facet interactions of one path. It is a guard against
+/// numerical runaway, not a bounce cap: with the true Smith Lambda the probability to reach it
+/// is negligible, and any weight stopped here is reported as [`Loss::Runaway`].
+pub const RUNAWAY_ORDER: u32 = 1 << 20;
+
+/// Receives what happens to the light of one photon.
+pub trait Observer<const C: usize> {
+    /// A ray escapes after `order` facet interactions into `side` (the side it travels in),
+    /// along `dir`, carrying `weight`.
+    fn escape(&mut self, order: u32, side: Side, dir: DVec3, weight: &[f64; C]);
+    /// A ray stops for `loss`, carrying `weight`.
+    fn lose(&mut self, loss: Loss, weight: &[f64; C]);
+}
+
+/// A ray of the walk: height, travel direction, side, weight and number of interactions so far.
+#[derive(Clone, Copy, Debug)]
+pub struct Ray<const C: usize> {
+    h: f64,
+    d: DVec3,
+    side: Side,
+    beta: [f64; C],
+    order: u32,
+}
+
+fn max_channel<const C: usize>(w: &[f64; C]) -> f64 {
+    w.iter().copied().fold(0.0, f64::max)
+}
+
+fn weight_is_valid<const C: usize>(w: &[f64; C]) -> bool {
+    w.iter().all(|x| x.is_finite() && *x >= 0.0)
+}
+
+impl<N: Ndf, H: HeightDistribution> Microsurface<N, H> {
+    /// Walks one photon arriving from `wi` (pointing towards the light; `wi_z > 0` from
+    /// outside, `wi_z < 0` from inside a dielectric) with unit weight in every channel, and
+    /// reports every escape and loss to `observer`. `stack` is scratch space for split branches.
+    pub fn trace<F, R, O, const C: usize>(
+        &self,
+        facet: &F,
+        policy: &EnergyPolicy,
+        wi: DVec3,
+        rng: &mut R,
+        stack: &mut Vec<Ray<C>>,
+        observer: &mut O,
+    ) where
+        F: Facet<C>,
+        R: Rng + ?Sized,
+        O: Observer<C>,
+    {
+        let side = if wi.z >= 0.0 { Side::Outside } else { Side::Inside };
+        let top = self.heights.top();
+        let h = match side {
+            Side::Outside => top,
+            Side::Inside => -top,
+        };
+        stack.clear();
+        stack.push(Ray { h, d: -wi, side, beta: [1.0; C], order: 0 });
+        while let Some(ray) = stack.pop() {
+            self.follow(facet, policy, ray, rng, stack, observer);
+        }
+    }
+
+    /// Follows one ray until it escapes, is absorbed or lost; split branches go onto `stack`.
+    fn follow<F, R, O, const C: usize>(
+        &self,
+        facet: &F,
+        policy: &EnergyPolicy,
+        mut ray: Ray<C>,
+        rng: &mut R,
+        stack: &mut Vec<Ray<C>>,
+        observer: &mut O,
+    ) where
+        F: Facet<C>,
+        R: Rng + ?Sized,
+        O: Observer<C>,
+    {
+        loop {
+            // The flipped frame (§4.3): on the inside, negate height and direction.
+            let (h, d) = match ray.side {
+                Side::Outside => (ray.h, ray.d),
+                Side::Inside => (-ray.h, -ray.d),
+            };
+            let tau = self.heights.depth(h);
+            if tau.is_nan() {
+                return observer.lose(Loss::Invalid, &ray.beta);
+            }
+            if tau.is_infinite() {
+                return observer.lose(Loss::Trapped, &ray.beta);
+            }
+            let rate = self.smith.rate(&self.ndf, d);
+            let tau = match fly(tau, d.z > 0.0, rate, exp1(rng)) {
+                Flight::Escape => return observer.escape(ray.order, ray.side, ray.d, &ray.beta),
+                Flight::Hit(tau) => tau,
+            };
+            let h = self.heights.height(tau);
+            ray.h = match ray.side {
+                Side::Outside => h,
+                Side::Inside => -h,
+            };
+            ray.order += 1;
+            if ray.order >= RUNAWAY_ORDER {
+                return observer.lose(Loss::Runaway, &ray.beta);
+            }
+            let m_flipped = self.normals.sample(&self.ndf, d, rng);
+            let m = match ray.side {
+                Side::Outside => m_flipped,
+                Side::Inside => -m_flipped,
+            };
+            let branch = match facet.interact(-ray.d, m, ray.side, rng) {
+                Interaction::One(b) => b,
+                Interaction::Two(a, b) => {
+                    if policy.split && max_channel(&ray.beta) >= policy.threshold {
+                        stack.push(continue_with(&ray, &b));
+                        a
+                    } else {
+                        match choose(&ray.beta, a, b, open01(rng)) {
+                            Some(chosen) => chosen,
+                            None => return,
+                        }
+                    }
+                }
+            };
+            ray = continue_with(&ray, &branch);
+            if !ray.d.is_finite() || !weight_is_valid(&ray.beta) {
+                return observer.lose(Loss::Invalid, &ray.beta);
+            }
+            let largest = max_channel(&ray.beta);
+            if largest == 0.0 {
+                return;
+            }
+            if largest < policy.threshold {
+                let survive = largest / policy.threshold;
+                if open01(rng) >= survive {
+                    return;
+                }
+                ray.beta = ray.beta.map(|b| b / survive);
+            }
+        }
+    }
+}
+
+/// The ray that follows `branch`.
+fn continue_with<const C: usize>(ray: &Ray<C>, branch: &Branch<C>) -> Ray<C> {
+    Ray {
+        d: branch.dir,
+        side: if branch.crosses { ray.side.other() } else { ray.side },
+        beta: std::array::from_fn(|i| ray.beta[i] * branch.weight[i]),
+        ..*ray
+    }
+}
+
+/// Chooses one of two exclusive branches with probability proportional to the weight each
+/// would carry (summed over channels), and divides its factor by that probability so the
+/// choice is unbiased (§4.6). `None` if neither branch carries weight.
+fn choose<const C: usize>(beta: &[f64; C], a: Branch<C>, b: Branch<C>, u: f64) -> Option<Branch<C>> {
+    let carried = |br: &Branch<C>| beta.iter().zip(&br.weight).map(|(x, w)| x * w).sum::<f64>();
+    let (wa, wb) = (carried(&a), carried(&b));
+    let total = wa + wb;
+    if total <= 0.0 {
+        return None;
+    }
+    let pa = wa / total;
+    let (mut chosen, p) = if u < pa { (a, pa) } else { (b, 1.0 - pa) };
+    chosen.weight = chosen.weight.map(|w| w / p);
+    Some(chosen)
+}

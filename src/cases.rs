@@ -1,0 +1,61 @@
+//! Expansion of a configuration into cases: the cartesian product of every sweep.
+
+use glam::DVec3;
+use itertools::iproduct;
+use serde::Serialize;
+
+use crate::config::{Config, HeightKind, IncidentSide, MaterialConfig, NdfKind, NormalsKind, SmithKind};
+
+/// One measurement: a surface, a facet material and an incident direction.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct Case {
+    pub index: usize,
+    pub ndf: NdfKind,
+    pub alpha_x: f64,
+    pub alpha_y: f64,
+    pub height: HeightKind,
+    pub smith: SmithKind,
+    pub normals: NormalsKind,
+    pub material: MaterialConfig,
+    pub theta_i_deg: f64,
+    pub phi_i_deg: f64,
+    pub side: IncidentSide,
+}
+
+impl Case {
+    /// The direction towards the light (§0): above the horizon from outside, below from inside.
+    pub fn incident_direction(&self) -> DVec3 {
+        let (st, ct) = self.theta_i_deg.to_radians().sin_cos();
+        let (sp, cp) = self.phi_i_deg.to_radians().sin_cos();
+        let z = match self.side {
+            IncidentSide::Outside => ct,
+            IncidentSide::Inside => -ct,
+        };
+        DVec3::new(st * cp, st * sp, z)
+    }
+}
+
+/// The cases of a configuration, in the order ndf, alpha, height, smith, normals, material,
+/// side, theta, phi (the last varies fastest). The index of a case is its position.
+pub fn expand(config: &Config) -> Vec<Case> {
+    let s = &config.surface;
+    let i = &config.incident;
+    let product = iproduct!(
+        s.ndf.values(),
+        s.alpha.values(),
+        s.height.values(),
+        s.smith.values(),
+        s.normals.values(),
+        config.material.values(),
+        i.side.values(),
+        i.theta_degrees(),
+        i.phi_deg.values()
+    );
+    product
+        .enumerate()
+        .map(|(index, (ndf, alpha, height, smith, normals, material, side, theta_i_deg, phi_i_deg))| {
+            let (alpha_x, alpha_y) = alpha.xy();
+            Case { index, ndf, alpha_x, alpha_y, height, smith, normals, material, theta_i_deg, phi_i_deg, side }
+        })
+        .collect()
+}

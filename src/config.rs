@@ -1,0 +1,543 @@
+//! The TOML run configuration: parsing, defaults and validation.
+//!
+//! Every list-valued field is a sweep; [`crate::cases`] expands the configuration into the
+//! cartesian product of cases. Validation names the field, the value and what is allowed.
+
+use std::fmt;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+/// A field that takes one value or a list of values (a sweep).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum OneOrMany<T> {
+    One(T),
+    Many(Vec<T>),
+}
+
+impl<T: Clone> OneOrMany<T> {
+    pub fn values(&self) -> Vec<T> {
+        match self {
+            OneOrMany::One(v) => vec![v.clone()],
+            OneOrMany::Many(v) => v.clone(),
+        }
+    }
+}
+
+/// A roughness entry: `0.5` (isotropic) or `[alpha_x, alpha_y]`.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum Alpha {
+    Isotropic(f64),
+    Anisotropic([f64; 2]),
+}
+
+impl Alpha {
+    pub fn xy(self) -> (f64, f64) {
+        match self {
+            Alpha::Isotropic(a) => (a, a),
+            Alpha::Anisotropic([x, y]) => (x, y),
+        }
+    }
+}
+
+/// A per-channel parameter: one value for all channels or `[r, g, b]`.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum Channels {
+    Mono(f64),
+    Rgb([f64; 3]),
+}
+
+impl Channels {
+    pub fn is_rgb(self) -> bool {
+        matches!(self, Channels::Rgb(_))
+    }
+
+    /// The values for `C` channels (a mono value is repeated).
+    pub fn to_array<const C: usize>(self) -> [f64; C] {
+        match self {
+            Channels::Mono(v) => [v; C],
+            Channels::Rgb(rgb) => std::array::from_fn(|i| rgb[i.min(2)]),
+        }
+    }
+
+    fn values(self) -> Vec<f64> {
+        match self {
+            Channels::Mono(v) => vec![v],
+            Channels::Rgb(rgb) => rgb.to_vec(),
+        }
+    }
+}
+
+impl fmt::Display for Channels {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Channels::Mono(v) => write!(f, "{v}"),
+            Channels::Rgb([r, g, b]) => write!(f, "[{r}, {g}, {b}]"),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum NdfKind {
+    Ggx,
+    Beckmann,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum HeightKind {
+    Uniform,
+    Gaussian,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum SmithKind {
+    Exact,
+    Symmetric,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum NormalsKind {
+    Vndf,
+    HammonRejection,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum FresnelKind {
+    None,
+    Schlick,
+    Exact,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum IncidentSide {
+    Outside,
+    Inside,
+}
+
+/// A facet material (`[material]` or `[[material]]` entries), tagged by `kind`.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum MaterialConfig {
+    Conductor {
+        #[serde(default = "fresnel_none")]
+        fresnel: FresnelKind,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        f0: Option<Channels>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        eta: Option<Channels>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        k: Option<Channels>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+    },
+    Dielectric {
+        eta: f64,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+    },
+    Diffuse {
+        #[serde(default = "unit_channels")]
+        albedo: Channels,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+    },
+    Hammon {
+        #[serde(default = "hammon_f0")]
+        f0: Channels,
+        #[serde(default = "unit_channels")]
+        albedo: Channels,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+    },
+}
+
+fn fresnel_none() -> FresnelKind {
+    FresnelKind::None
+}
+fn unit_channels() -> Channels {
+    Channels::Mono(1.0)
+}
+/// Hammon 2017 uses F0 = 0.02 (water-like dielectric).
+fn hammon_f0() -> Channels {
+    Channels::Mono(0.02)
+}
+
+impl MaterialConfig {
+    /// A short label for tables: the user's `name`, or the kind and its parameters.
+    pub fn label(&self) -> String {
+        match self {
+            MaterialConfig::Conductor { name: Some(n), .. }
+            | MaterialConfig::Dielectric { name: Some(n), .. }
+            | MaterialConfig::Diffuse { name: Some(n), .. }
+            | MaterialConfig::Hammon { name: Some(n), .. } => n.clone(),
+            MaterialConfig::Conductor { fresnel, f0, eta, k, .. } => match fresnel {
+                FresnelKind::None => "conductor F=1".into(),
+                FresnelKind::Schlick => format!("conductor schlick f0={}", f0.unwrap_or(Channels::Mono(f64::NAN))),
+                FresnelKind::Exact => format!(
+                    "conductor eta={} k={}",
+                    eta.unwrap_or(Channels::Mono(f64::NAN)),
+                    k.unwrap_or(Channels::Mono(f64::NAN))
+                ),
+            },
+            MaterialConfig::Dielectric { eta, .. } => format!("dielectric eta={eta}"),
+            MaterialConfig::Diffuse { albedo, .. } => format!("diffuse albedo={albedo}"),
+            MaterialConfig::Hammon { f0, albedo, .. } => format!("hammon f0={f0} albedo={albedo}"),
+        }
+    }
+
+    pub fn kind(&self) -> &'static str {
+        match self {
+            MaterialConfig::Conductor { .. } => "conductor",
+            MaterialConfig::Dielectric { .. } => "dielectric",
+            MaterialConfig::Diffuse { .. } => "diffuse",
+            MaterialConfig::Hammon { .. } => "hammon",
+        }
+    }
+
+    /// Whether light can pass to the other side (only dielectrics transmit).
+    pub fn transmits(&self) -> bool {
+        matches!(self, MaterialConfig::Dielectric { .. })
+    }
+
+    fn channel_params(&self) -> Vec<Channels> {
+        match self {
+            MaterialConfig::Conductor { f0, eta, k, .. } => [f0, eta, k].into_iter().flatten().copied().collect(),
+            MaterialConfig::Dielectric { .. } => vec![],
+            MaterialConfig::Diffuse { albedo, .. } => vec![*albedo],
+            MaterialConfig::Hammon { f0, albedo, .. } => vec![*f0, *albedo],
+        }
+    }
+
+    pub fn is_rgb(&self) -> bool {
+        self.channel_params().iter().any(|c| c.is_rgb())
+    }
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceConfig {
+    #[serde(default = "default_ndf")]
+    pub ndf: OneOrMany<NdfKind>,
+    pub alpha: OneOrMany<Alpha>,
+    #[serde(default = "default_height")]
+    pub height: OneOrMany<HeightKind>,
+    #[serde(default = "default_smith")]
+    pub smith: OneOrMany<SmithKind>,
+    #[serde(default = "default_normals")]
+    pub normals: OneOrMany<NormalsKind>,
+}
+
+fn default_ndf() -> OneOrMany<NdfKind> {
+    OneOrMany::One(NdfKind::Ggx)
+}
+fn default_height() -> OneOrMany<HeightKind> {
+    OneOrMany::One(HeightKind::Uniform)
+}
+fn default_smith() -> OneOrMany<SmithKind> {
+    OneOrMany::One(SmithKind::Exact)
+}
+fn default_normals() -> OneOrMany<NormalsKind> {
+    OneOrMany::One(NormalsKind::Vndf)
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct IncidentConfig {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub theta_deg: Option<OneOrMany<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub theta_rad: Option<OneOrMany<f64>>,
+    #[serde(default = "default_phi")]
+    pub phi_deg: OneOrMany<f64>,
+    #[serde(default = "default_side")]
+    pub side: OneOrMany<IncidentSide>,
+}
+
+fn default_phi() -> OneOrMany<f64> {
+    OneOrMany::One(0.0)
+}
+fn default_side() -> OneOrMany<IncidentSide> {
+    OneOrMany::One(IncidentSide::Outside)
+}
+
+impl IncidentConfig {
+    /// The incident polar angles in degrees, whichever unit the config used.
+    pub fn theta_degrees(&self) -> Vec<f64> {
+        match (&self.theta_deg, &self.theta_rad) {
+            (Some(d), _) => d.values(),
+            (None, Some(r)) => r.values().into_iter().map(f64::to_degrees).collect(),
+            (None, None) => vec![],
+        }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DetectorConfig {
+    #[serde(default = "default_cos_bins")]
+    pub cos_theta_bins: usize,
+    #[serde(default = "default_phi_bins")]
+    pub phi_bins: usize,
+    /// Orders `>= max_order` are folded into the last order, "K+". The walk is not capped.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_order: Option<u32>,
+}
+
+fn default_cos_bins() -> usize {
+    32
+}
+fn default_phi_bins() -> usize {
+    64
+}
+
+impl Default for DetectorConfig {
+    fn default() -> Self {
+        Self { cos_theta_bins: default_cos_bins(), phi_bins: default_phi_bins(), max_order: None }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct EnergyConfig {
+    #[serde(default = "default_split")]
+    pub split: bool,
+    #[serde(default = "default_threshold")]
+    pub threshold: f64,
+}
+
+fn default_split() -> bool {
+    true
+}
+fn default_threshold() -> f64 {
+    0.1
+}
+
+impl Default for EnergyConfig {
+    fn default() -> Self {
+        Self { split: default_split(), threshold: default_threshold() }
+    }
+}
+
+/// A whole run configuration.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Config {
+    /// Photons per case.
+    pub paths: u64,
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    pub surface: SurfaceConfig,
+    pub material: OneOrMany<MaterialConfig>,
+    pub incident: IncidentConfig,
+    #[serde(default)]
+    pub detector: DetectorConfig,
+    #[serde(default)]
+    pub energy: EnergyConfig,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+
+/// A configuration error: which field, which value, and what is allowed.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("cannot read config {path}: {source}")]
+    Read { path: String, source: std::io::Error },
+    #[error("config {path} is not valid: {message}")]
+    Parse { path: String, message: String },
+    #[error("`{field}` = {value} is not allowed: {allowed}")]
+    Invalid { field: String, value: String, allowed: String },
+}
+
+fn invalid(field: impl Into<String>, value: impl fmt::Display, allowed: impl Into<String>) -> ConfigError {
+    ConfigError::Invalid { field: field.into(), value: value.to_string(), allowed: allowed.into() }
+}
+
+impl Config {
+    /// Reads, parses and validates a TOML configuration file.
+    pub fn load(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| ConfigError::Read { path: path.display().to_string(), source })?;
+        let config = Self::parse(&text).map_err(|e| match e {
+            ConfigError::Parse { message, .. } => ConfigError::Parse { path: path.display().to_string(), message },
+            other => other,
+        })?;
+        Ok(config)
+    }
+
+    /// Parses and validates TOML text.
+    pub fn parse(text: &str) -> Result<Self, ConfigError> {
+        let config: Config =
+            toml::from_str(text).map_err(|e| ConfigError::Parse { path: "<text>".into(), message: e.to_string() })?;
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// Checks every field against what the simulator supports.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        if self.paths < 2 {
+            return Err(invalid("paths", self.paths, "at least 2 photons per case (standard errors need two)"));
+        }
+        let s = &self.surface;
+        non_empty("surface.ndf", &s.ndf)?;
+        non_empty("surface.height", &s.height)?;
+        non_empty("surface.smith", &s.smith)?;
+        non_empty("surface.normals", &s.normals)?;
+        non_empty("surface.alpha", &s.alpha)?;
+        for a in s.alpha.values() {
+            let (x, y) = a.xy();
+            for v in [x, y] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(invalid("surface.alpha", v, "a finite roughness > 0 (tested from 1e-3 to 3)"));
+                }
+            }
+        }
+        let materials = self.material.values();
+        if materials.is_empty() {
+            return Err(invalid("material", "[]", "at least one material"));
+        }
+        for (i, m) in materials.iter().enumerate() {
+            validate_material(&format!("material[{i}]"), m)?;
+        }
+        let i = &self.incident;
+        if i.theta_deg.is_some() && i.theta_rad.is_some() {
+            return Err(invalid("incident.theta_rad", "given with incident.theta_deg", "one of theta_deg or theta_rad"));
+        }
+        let (field, values, limit) = match (&i.theta_deg, &i.theta_rad) {
+            (Some(d), _) => ("incident.theta_deg", d.values(), 90.0),
+            (None, Some(r)) => ("incident.theta_rad", r.values(), std::f64::consts::FRAC_PI_2),
+            (None, None) => return Err(invalid("incident.theta_deg", "missing", "a polar angle or a list of them")),
+        };
+        if values.is_empty() {
+            return Err(invalid(field, "[]", "at least one incident angle"));
+        }
+        for t in values {
+            if !(t.is_finite() && (0.0..limit).contains(&t)) {
+                return Err(invalid(field, t, format!("an angle in [0, {limit})")));
+            }
+        }
+        non_empty("incident.phi_deg", &i.phi_deg)?;
+        for p in i.phi_deg.values() {
+            if !p.is_finite() {
+                return Err(invalid("incident.phi_deg", p, "a finite azimuth in degrees"));
+            }
+        }
+        non_empty("incident.side", &i.side)?;
+        if i.side.values().contains(&IncidentSide::Inside) {
+            if let Some(m) = materials.iter().find(|m| !m.transmits()) {
+                return Err(invalid(
+                    "incident.side",
+                    "\"inside\"",
+                    format!("light from inside needs dielectric materials only, but a material is {}", m.kind()),
+                ));
+            }
+        }
+        let d = &self.detector;
+        if d.cos_theta_bins == 0 || d.cos_theta_bins > 4096 {
+            return Err(invalid("detector.cos_theta_bins", d.cos_theta_bins, "an integer from 1 to 4096"));
+        }
+        if d.phi_bins == 0 || d.phi_bins > 4096 {
+            return Err(invalid("detector.phi_bins", d.phi_bins, "an integer from 1 to 4096"));
+        }
+        if d.max_order == Some(0) {
+            return Err(invalid("detector.max_order", 0, "an order >= 1, or leave it out to keep every order"));
+        }
+        let e = &self.energy;
+        if !(e.threshold.is_finite() && (0.0..=1.0).contains(&e.threshold)) || (e.split && e.threshold == 0.0) {
+            return Err(invalid(
+                "energy.threshold",
+                e.threshold,
+                "a weight in (0, 1] when split = true (splitting stops below it), or in [0, 1] with split = false",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Whether the run carries three colour channels (any material parameter is `[r, g, b]`).
+    pub fn is_rgb(&self) -> bool {
+        self.material.values().iter().any(MaterialConfig::is_rgb)
+    }
+}
+
+fn non_empty<T: Clone>(field: &str, v: &OneOrMany<T>) -> Result<(), ConfigError> {
+    if v.values().is_empty() {
+        return Err(invalid(field, "[]", "at least one value (an empty list expands to no cases)"));
+    }
+    Ok(())
+}
+
+fn check_channels(field: String, c: Channels, ok: impl Fn(f64) -> bool, allowed: &str) -> Result<(), ConfigError> {
+    for v in c.values() {
+        if !(v.is_finite() && ok(v)) {
+            return Err(invalid(field, c, allowed.to_string()));
+        }
+    }
+    Ok(())
+}
+
+fn validate_material(field: &str, m: &MaterialConfig) -> Result<(), ConfigError> {
+    let unit = |v: f64| (0.0..=1.0).contains(&v);
+    match m {
+        MaterialConfig::Conductor { fresnel, f0, eta, k, .. } => {
+            let needs = |name: &str, p: &Option<Channels>, present: bool| {
+                if p.is_some() != present {
+                    let allowed = if present {
+                        format!("fresnel = \"{}\" needs `{name}`", fresnel_name(*fresnel))
+                    } else {
+                        format!("`{name}` is not used with fresnel = \"{}\"", fresnel_name(*fresnel))
+                    };
+                    let value = p.map_or("missing".to_string(), |c| c.to_string());
+                    return Err(invalid(format!("{field}.{name}"), value, allowed));
+                }
+                Ok(())
+            };
+            needs("f0", f0, *fresnel == FresnelKind::Schlick)?;
+            needs("eta", eta, *fresnel == FresnelKind::Exact)?;
+            needs("k", k, *fresnel == FresnelKind::Exact)?;
+            if let Some(f0) = f0 {
+                check_channels(format!("{field}.f0"), *f0, unit, "reflectances in [0, 1]")?;
+            }
+            if let Some(eta) = eta {
+                check_channels(format!("{field}.eta"), *eta, |v| v > 0.0, "real parts of the index > 0")?;
+            }
+            if let Some(k) = k {
+                check_channels(format!("{field}.k"), *k, |v| v >= 0.0, "extinction coefficients >= 0")?;
+            }
+        }
+        MaterialConfig::Dielectric { eta, .. } => {
+            if !(eta.is_finite() && *eta > 0.0 && *eta != 1.0) {
+                return Err(invalid(
+                    format!("{field}.eta"),
+                    eta,
+                    "a relative index n_inside / n_outside > 0 and != 1 (an index-matched interface is invisible)",
+                ));
+            }
+        }
+        MaterialConfig::Diffuse { albedo, .. } => {
+            check_channels(format!("{field}.albedo"), *albedo, unit, "albedos in [0, 1]")?;
+        }
+        MaterialConfig::Hammon { f0, albedo, .. } => {
+            check_channels(format!("{field}.f0"), *f0, unit, "reflectances in [0, 1]")?;
+            check_channels(format!("{field}.albedo"), *albedo, unit, "albedos in [0, 1]")?;
+        }
+    }
+    Ok(())
+}
+
+fn fresnel_name(f: FresnelKind) -> &'static str {
+    match f {
+        FresnelKind::None => "none",
+        FresnelKind::Schlick => "schlick",
+        FresnelKind::Exact => "exact",
+    }
+}

@@ -1,0 +1,310 @@
+//! Output files of a run: `lobes.csv`, `summary.csv` and `run.json`, each written atomically
+//! (temporary file in the output directory, then rename), and only after every case finished.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+
+use crate::Simulation;
+use crate::cases::Case;
+use crate::config::{Config, IncidentSide};
+use crate::detector::{Detector, Hemisphere, Tally};
+use crate::run::CaseResult;
+
+const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
+
+/// The serde name of a config enum value (`"ggx"`, `"hammon-rejection"`, ...).
+fn name<T: Serialize>(value: &T) -> String {
+    match serde_json::to_value(value) {
+        Ok(serde_json::Value::String(s)) => s,
+        other => format!("{other:?}"),
+    }
+}
+
+/// The leading columns that identify a case.
+const CASE_COLUMNS: [&str; 11] = [
+    "case",
+    "ndf",
+    "alpha_x",
+    "alpha_y",
+    "height",
+    "smith",
+    "normals",
+    "material",
+    "theta_i_deg",
+    "phi_i_deg",
+    "side",
+];
+
+fn case_fields(case: &Case) -> Vec<String> {
+    vec![
+        case.index.to_string(),
+        name(&case.ndf),
+        case.alpha_x.to_string(),
+        case.alpha_y.to_string(),
+        name(&case.height),
+        name(&case.smith),
+        name(&case.normals),
+        case.material.label(),
+        case.theta_i_deg.to_string(),
+        case.phi_i_deg.to_string(),
+        name(&case.side),
+    ]
+}
+
+/// Sign of cos(theta) of the directions in a hemisphere: reflection goes back to the light's
+/// side, transmission to the other one.
+fn hemisphere_sign(side: IncidentSide, hemisphere: Hemisphere) -> f64 {
+    match (side, hemisphere) {
+        (IncidentSide::Outside, Hemisphere::R) | (IncidentSide::Inside, Hemisphere::T) => 1.0,
+        _ => -1.0,
+    }
+}
+
+fn hemispheres(case: &Case) -> &'static [Hemisphere] {
+    if case.material.transmits() { &[Hemisphere::R, Hemisphere::T] } else { &[Hemisphere::R] }
+}
+
+/// Energy accounting of one case, per channel (§9.2).
+#[derive(Clone, Debug, Serialize)]
+pub struct EnergyBalance {
+    pub reflected: Vec<f64>,
+    pub transmitted: Vec<f64>,
+    pub absorbed: Vec<f64>,
+    pub absorbed_stderr: Vec<f64>,
+    pub lost_trapped: Vec<f64>,
+    pub lost_invalid: Vec<f64>,
+    pub lost_runaway: Vec<f64>,
+    /// Energy in the folded "K+" order (`detector.max_order`), or 0.
+    pub folded: Vec<f64>,
+    /// Highest order slot with light in it.
+    pub highest_order: usize,
+}
+
+fn per_channel<const C: usize>(f: impl Fn(usize) -> f64) -> Vec<f64> {
+    (0..C).map(f).collect()
+}
+
+impl EnergyBalance {
+    fn of<const C: usize>(d: &Detector<C>) -> Self {
+        let n = d.photons;
+        let mean = |t: &Tally<C>, c| t.mean_and_stderr(n, c).0;
+        let all = &d.orders[0];
+        let last = d.highest_slot();
+        Self {
+            reflected: per_channel::<C>(|c| mean(&all.albedo[0], c)),
+            transmitted: per_channel::<C>(|c| mean(&all.albedo[1], c)),
+            absorbed: per_channel::<C>(|c| 1.0 - mean(&d.accounted, c)),
+            absorbed_stderr: per_channel::<C>(|c| d.accounted.mean_and_stderr(n, c).1),
+            lost_trapped: per_channel::<C>(|c| mean(&d.lost[0], c)),
+            lost_invalid: per_channel::<C>(|c| mean(&d.lost[1], c)),
+            lost_runaway: per_channel::<C>(|c| mean(&d.lost[2], c)),
+            folded: per_channel::<C>(|c| {
+                if d.is_folded(last) { mean(&d.orders[last].albedo[0], c) + mean(&d.orders[last].albedo[1], c) } else { 0.0 }
+            }),
+            highest_order: last,
+        }
+    }
+
+    pub fn from_result(r: &CaseResult) -> Self {
+        match r {
+            CaseResult::Mono(d) => Self::of(d),
+            CaseResult::Rgb(d) => Self::of(d),
+        }
+    }
+
+    pub fn lost(&self) -> f64 {
+        self.lost_trapped.iter().chain(&self.lost_invalid).chain(&self.lost_runaway).sum()
+    }
+}
+
+fn channel_header(rgb: bool) -> Vec<&'static str> {
+    if rgb { vec!["channel"] } else { vec![] }
+}
+
+fn lobe_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Detector<C>) -> Result<()> {
+    let fields = case_fields(case);
+    let grid = d.grid;
+    let n = d.photons;
+    for (slot, tallies) in d.orders.iter().enumerate() {
+        for &hemisphere in hemispheres(case) {
+            let sign = hemisphere_sign(case.side, hemisphere);
+            for ic in 0..grid.cos_bins {
+                let (lo, hi) = grid.cos_edges(ic);
+                let (cos_lo, cos_hi) = if sign > 0.0 { (lo, hi) } else { (-hi, -lo) };
+                let solid = grid.projected_solid_angle(ic);
+                for ip in 0..grid.phi_bins {
+                    let (phi_lo, phi_hi) = grid.phi_edges_deg(ip);
+                    let tally = &tallies.bins[hemisphere as usize * grid.bins() + ic * grid.phi_bins + ip];
+                    for c in 0..C {
+                        let (energy, se) = tally.mean_and_stderr(n, c);
+                        let mut row = fields.clone();
+                        row.push(slot.to_string());
+                        row.push(format!("{hemisphere:?}"));
+                        if C > 1 {
+                            row.push(CHANNEL_NAMES[c].to_string());
+                        }
+                        row.extend([cos_lo, cos_hi, phi_lo, phi_hi, energy, se].map(|v| v.to_string()));
+                        row.push(tally.count.to_string());
+                        row.push((energy / solid).to_string());
+                        row.push((se / solid).to_string());
+                        w.write_record(&row)?;
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn summary_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Detector<C>) -> Result<()> {
+    let fields = case_fields(case);
+    let n = d.photons;
+    let mut write = |order: usize, what: &str, c: usize, value: f64, se: f64, folded: bool| {
+        let mut row = fields.clone();
+        row.push(n.to_string());
+        row.push(order.to_string());
+        row.push(what.to_string());
+        if C > 1 {
+            row.push(CHANNEL_NAMES[c].to_string());
+        }
+        row.extend([value.to_string(), se.to_string(), folded.to_string()]);
+        w.write_record(&row)
+    };
+    for (slot, tallies) in d.orders.iter().enumerate() {
+        for &hemisphere in hemispheres(case) {
+            for c in 0..C {
+                let (albedo, se) = tallies.albedo[hemisphere as usize].mean_and_stderr(n, c);
+                write(slot, &format!("{hemisphere:?}"), c, albedo, se, d.is_folded(slot))?;
+            }
+        }
+    }
+    for c in 0..C {
+        let (accounted, se) = d.accounted.mean_and_stderr(n, c);
+        write(0, "absorbed", c, 1.0 - accounted, se, false)?;
+        let lost: f64 = d.lost.iter().map(|t| t.mean_and_stderr(n, c).0).sum();
+        let lost_se = d.lost.iter().map(|t| t.mean_and_stderr(n, c).1.powi(2)).sum::<f64>().sqrt();
+        write(0, "lost", c, lost, lost_se, false)?;
+    }
+    Ok(())
+}
+
+/// The CSV text of `lobes.csv` (one row per case, order, hemisphere, bin and channel).
+pub fn lobes_csv(sim: &Simulation) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<&str> = CASE_COLUMNS.to_vec();
+    header.extend(["order", "hemisphere"]);
+    header.extend(channel_header(sim.rgb));
+    header.extend(["cos_lo", "cos_hi", "phi_lo_deg", "phi_hi_deg", "energy", "energy_stderr", "count", "bsdf", "bsdf_stderr"]);
+    w.write_record(&header)?;
+    for (case, result) in sim.cases.iter().zip(&sim.results) {
+        match result {
+            CaseResult::Mono(d) => lobe_rows(&mut w, case, d)?,
+            CaseResult::Rgb(d) => lobe_rows(&mut w, case, d)?,
+        }
+    }
+    Ok(w.into_inner()?)
+}
+
+/// The CSV text of `summary.csv` (albedo per case, order, hemisphere; absorbed; lost).
+pub fn summary_csv(sim: &Simulation) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<&str> = CASE_COLUMNS.to_vec();
+    header.extend(["paths", "order", "hemisphere"]);
+    header.extend(channel_header(sim.rgb));
+    header.extend(["albedo", "albedo_stderr", "folded"]);
+    w.write_record(&header)?;
+    for (case, result) in sim.cases.iter().zip(&sim.results) {
+        match result {
+            CaseResult::Mono(d) => summary_rows(&mut w, case, d)?,
+            CaseResult::Rgb(d) => summary_rows(&mut w, case, d)?,
+        }
+    }
+    Ok(w.into_inner()?)
+}
+
+#[derive(Serialize)]
+struct CaseReport<'a> {
+    #[serde(flatten)]
+    case: &'a Case,
+    energy: EnergyBalance,
+}
+
+#[derive(Serialize)]
+struct RunReport<'a> {
+    smithwalk_version: &'static str,
+    config: &'a Config,
+    seed: u64,
+    paths: u64,
+    threads: usize,
+    chunk_photons: u64,
+    wall_seconds: f64,
+    paths_per_second: f64,
+    cases: Vec<CaseReport<'a>>,
+}
+
+/// The JSON text of `run.json`: resolved config, version, seed, paths, timing, energy balance.
+pub fn run_json(sim: &Simulation, config: &Config) -> Result<Vec<u8>> {
+    let total = config.paths as f64 * sim.cases.len() as f64;
+    let report = RunReport {
+        smithwalk_version: env!("CARGO_PKG_VERSION"),
+        config,
+        seed: config.seed,
+        paths: config.paths,
+        threads: sim.threads,
+        chunk_photons: crate::run::CHUNK,
+        wall_seconds: sim.wall_seconds,
+        paths_per_second: total / sim.wall_seconds.max(1e-9),
+        cases: sim
+            .cases
+            .iter()
+            .zip(&sim.results)
+            .map(|(case, r)| CaseReport { case, energy: EnergyBalance::from_result(r) })
+            .collect(),
+    };
+    let mut text = serde_json::to_vec_pretty(&report)?;
+    text.push(b'\n');
+    Ok(text)
+}
+
+/// Output files are ordinary readable files (temporary files start private).
+#[cfg(unix)]
+fn make_readable(file: &std::fs::File) -> std::io::Result<()> {
+    use std::os::unix::fs::PermissionsExt;
+    file.set_permissions(std::fs::Permissions::from_mode(0o644))
+}
+
+#[cfg(not(unix))]
+fn make_readable(_file: &std::fs::File) -> std::io::Result<()> {
+    Ok(())
+}
+
+/// Makes sure `dir` exists and is writable, before any simulation time is spent.
+pub fn prepare_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("--out {}: cannot create the output directory", dir.display()))?;
+    tempfile::NamedTempFile::new_in(dir)
+        .with_context(|| format!("--out {}: the output directory is not writable", dir.display()))?;
+    Ok(())
+}
+
+/// Writes all files: every one goes to a temporary file first; only when all are complete are
+/// they renamed into place, so a failure leaves no partial or corrupt output.
+pub fn write_atomically(dir: &Path, files: &[(&str, Vec<u8>)]) -> Result<Vec<PathBuf>> {
+    let mut staged = Vec::new();
+    for (file, bytes) in files {
+        let mut tmp = tempfile::NamedTempFile::new_in(dir)
+            .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
+        tmp.write_all(bytes).with_context(|| format!("cannot write {file}"))?;
+        make_readable(tmp.as_file()).with_context(|| format!("cannot set the permissions of {file}"))?;
+        tmp.as_file().sync_all().with_context(|| format!("cannot write {file}"))?;
+        staged.push((tmp, dir.join(file)));
+    }
+    let mut written = Vec::new();
+    for (tmp, path) in staged {
+        tmp.persist(&path).with_context(|| format!("cannot rename into {}", path.display()))?;
+        written.push(path);
+    }
+    Ok(written)
+}

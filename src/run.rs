@@ -1,0 +1,201 @@
+//! Running cases: the work is cut into fixed chunks of photons, each with its own random
+//! stream derived from (seed, case, chunk), and spread over a thread pool. Detectors are merged
+//! with exact integer sums, so outputs are bit-identical for any thread count.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use indicatif::ProgressBar;
+use microsurface::facet::{Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Lambertian};
+use microsurface::height::{GaussianHeight, HeightDistribution, UniformHeight};
+use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
+use microsurface::normals::Normals;
+use microsurface::smith::Smith;
+use microsurface::walk::{EnergyPolicy, Microsurface};
+use rand_pcg::Pcg64Mcg;
+
+use crate::cases::Case;
+use crate::config::{Config, FresnelKind, HeightKind, MaterialConfig, NdfKind, NormalsKind, SmithKind};
+use crate::detector::{Detector, Grid};
+
+/// Photons per chunk: the unit of work and of random streams. Part of the output's identity:
+/// changing it changes which random numbers each photon uses.
+pub const CHUNK: u64 = 1 << 14;
+
+/// What every case of a run shares.
+#[derive(Clone, Copy, Debug)]
+pub struct RunSettings {
+    pub paths: u64,
+    pub seed: u64,
+    pub grid: Grid,
+    pub max_order: Option<u32>,
+    pub policy: EnergyPolicy,
+}
+
+impl RunSettings {
+    pub fn from_config(config: &Config) -> Self {
+        Self {
+            paths: config.paths,
+            seed: config.seed,
+            grid: Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins },
+            max_order: config.detector.max_order,
+            policy: EnergyPolicy { split: config.energy.split, threshold: config.energy.threshold },
+        }
+    }
+
+    fn chunks(&self) -> u64 {
+        self.paths.div_ceil(CHUNK)
+    }
+}
+
+/// SplitMix64 finalizer: a bijective mixer of 64-bit words.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce5_e4b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// The random stream of one chunk of one case, derived from (seed, case, chunk) only.
+pub fn chunk_rng(seed: u64, case: usize, chunk: u64) -> Pcg64Mcg {
+    let a = mix(seed ^ mix(case as u64 ^ mix(chunk)));
+    let b = mix(a ^ 0x5851_f42d_4c95_7f2d);
+    Pcg64Mcg::new(((a as u128) << 64) | b as u128)
+}
+
+/// The result of one case: its detector, in one or three channels.
+#[derive(Clone, Debug)]
+pub enum CaseResult {
+    Mono(Detector<1>),
+    Rgb(Detector<3>),
+}
+
+/// Simulates one case over `threads` worker threads of `pool`.
+pub fn simulate_case(
+    case: &Case,
+    settings: &RunSettings,
+    rgb: bool,
+    pool: &rayon::ThreadPool,
+    progress: &ProgressBar,
+) -> CaseResult {
+    if rgb {
+        CaseResult::Rgb(with_ndf::<3>(case, settings, pool, progress))
+    } else {
+        CaseResult::Mono(with_ndf::<1>(case, settings, pool, progress))
+    }
+}
+
+fn with_ndf<const C: usize>(
+    case: &Case,
+    settings: &RunSettings,
+    pool: &rayon::ThreadPool,
+    progress: &ProgressBar,
+) -> Detector<C> {
+    let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
+    match case.ndf {
+        NdfKind::Ggx => with_height::<Ggx, C>(Ggx(roughness), case, settings, pool, progress),
+        NdfKind::Beckmann => with_height::<Beckmann, C>(Beckmann(roughness), case, settings, pool, progress),
+    }
+}
+
+fn with_height<N: Ndf, const C: usize>(
+    ndf: N,
+    case: &Case,
+    settings: &RunSettings,
+    pool: &rayon::ThreadPool,
+    progress: &ProgressBar,
+) -> Detector<C> {
+    let smith = match case.smith {
+        SmithKind::Exact => Smith::Exact,
+        SmithKind::Symmetric => Smith::Symmetric,
+    };
+    let normals = match case.normals {
+        NormalsKind::Vndf => Normals::Visible,
+        NormalsKind::HammonRejection => Normals::HammonRejection,
+    };
+    match case.height {
+        HeightKind::Uniform => {
+            let surface = Microsurface { ndf, heights: UniformHeight, smith, normals };
+            with_material(&surface, case, settings, pool, progress)
+        }
+        HeightKind::Gaussian => {
+            let surface = Microsurface { ndf, heights: GaussianHeight, smith, normals };
+            with_material(&surface, case, settings, pool, progress)
+        }
+    }
+}
+
+fn with_material<N: Ndf, H: HeightDistribution, const C: usize>(
+    surface: &Microsurface<N, H>,
+    case: &Case,
+    settings: &RunSettings,
+    pool: &rayon::ThreadPool,
+    progress: &ProgressBar,
+) -> Detector<C> {
+    match &case.material {
+        MaterialConfig::Conductor { fresnel, f0, eta, k, .. } => {
+            let fresnel = match fresnel {
+                FresnelKind::None => ConductorFresnel::None,
+                FresnelKind::Schlick => ConductorFresnel::Schlick { f0: channels(f0) },
+                FresnelKind::Exact => ConductorFresnel::Exact { eta: channels(eta), k: channels(k) },
+            };
+            run_chunks(surface, &Conductor { fresnel }, case, settings, pool, progress)
+        }
+        MaterialConfig::Dielectric { eta, .. } => {
+            run_chunks(surface, &Dielectric { eta: *eta }, case, settings, pool, progress)
+        }
+        MaterialConfig::Diffuse { albedo, .. } => {
+            run_chunks(surface, &Lambertian { albedo: albedo.to_array() }, case, settings, pool, progress)
+        }
+        MaterialConfig::Hammon { f0, albedo, .. } => {
+            let facet = Hammon { f0: f0.to_array(), albedo: albedo.to_array() };
+            run_chunks(surface, &facet, case, settings, pool, progress)
+        }
+    }
+}
+
+fn channels<const C: usize>(c: &Option<crate::config::Channels>) -> [f64; C] {
+    c.expect("validated: the Fresnel mode's parameters are present").to_array()
+}
+
+/// Runs every chunk of a case on the pool: each worker takes the next chunk index from a
+/// shared counter and accumulates into its own detector; the detectors are merged at the end.
+fn run_chunks<N, H, F, const C: usize>(
+    surface: &Microsurface<N, H>,
+    facet: &F,
+    case: &Case,
+    settings: &RunSettings,
+    pool: &rayon::ThreadPool,
+    progress: &ProgressBar,
+) -> Detector<C>
+where
+    N: Ndf,
+    H: HeightDistribution,
+    F: Facet<C>,
+{
+    let wi = case.incident_direction();
+    let next = AtomicU64::new(0);
+    let chunks = settings.chunks();
+    let partials = pool.broadcast(|_| {
+        let mut detector = Detector::<C>::new(settings.grid, wi, settings.max_order);
+        let mut stack = Vec::new();
+        loop {
+            let chunk = next.fetch_add(1, Ordering::Relaxed);
+            if chunk >= chunks {
+                break detector;
+            }
+            let photons = CHUNK.min(settings.paths - chunk * CHUNK);
+            let mut rng = chunk_rng(settings.seed, case.index, chunk);
+            for _ in 0..photons {
+                surface.trace(facet, &settings.policy, wi, &mut rng, &mut stack, &mut detector);
+                detector.end_photon();
+            }
+            progress.inc(photons);
+        }
+    });
+    let mut partials = partials.into_iter();
+    let mut total = partials.next().unwrap_or_else(|| Detector::new(settings.grid, wi, settings.max_order));
+    for p in partials {
+        total.merge(&p);
+    }
+    total
+}
