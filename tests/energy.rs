@@ -1,0 +1,143 @@
+//! Energy conservation and per-order reference values (THEORY.md §9.2, §9.4).
+//!
+//! * White furnace: conductor F = 1, Lambertian albedo 1 and dielectric R + T, GGX and
+//!   Beckmann, alpha in {0.1, 0.5, 1, 2}, isotropic and anisotropic, theta_i in {0, 60, 89} deg,
+//!   20 000 photons each. Every photon must be accounted for: the absorbed energy is within 4
+//!   standard errors of 0 (for F = 1 and albedo 1 the SE is 0 and the balance must be exact),
+//!   and no weight is lost to trapping, NaN or runaway.
+//! * Per-order albedos against the independent random-walk and quadrature tables of §9.4
+//!   (conductor: 2e6 photons, SE <= 4e-4; Lambertian and dielectric: 1e6 photons), within 4
+//!   combined standard errors (ours, the table's binomial SE, and its 4-decimal rounding).
+
+mod common;
+
+use common::{albedo, mono, simulate};
+use smithwalk::detector::Hemisphere;
+use smithwalk::output::EnergyBalance;
+
+#[test]
+fn white_furnace() {
+    let materials = [
+        "[[material]]\nkind = \"conductor\"",
+        "[[material]]\nkind = \"diffuse\"\nalbedo = 1.0",
+        "[[material]]\nkind = \"dielectric\"\neta = 1.5",
+    ];
+    for ndf in ["ggx", "beckmann"] {
+        let toml = format!(
+            "paths = 20_000\nseed = 5\n[surface]\nndf = \"{ndf}\"\nalpha = [0.1, 0.5, 1.0, 2.0, [0.1, 0.5], [2.0, 0.5]]\n{}\n[incident]\ntheta_deg = [0, 60, 89]\nphi_deg = 30\n[detector]\ncos_theta_bins = 4\nphi_bins = 4\nmax_order = 4\n",
+            materials.join("\n")
+        );
+        let sim = simulate(&toml, 2);
+        for (case, result) in sim.cases.iter().zip(&sim.results) {
+            let e = EnergyBalance::from_result(result);
+            let label = format!("{ndf} alpha=({},{}) {} theta={}", case.alpha_x, case.alpha_y, case.material.label(), case.theta_i_deg);
+            assert_eq!(e.lost(), 0.0, "{label}: weight lost {e:?}");
+            let (absorbed, se) = (e.absorbed[0], e.absorbed_stderr[0]);
+            assert!(absorbed.abs() <= 4.0 * se + 1e-12, "{label}: absorbed {absorbed} +- {se}");
+            let r_plus_t = e.reflected[0] + e.transmitted[0];
+            assert!((r_plus_t - 1.0).abs() <= 4.0 * se + 1e-12, "{label}: R + T = {r_plus_t} +- {se}");
+            if !case.material.transmits() {
+                assert_eq!(e.transmitted[0], 0.0, "{label}");
+            }
+        }
+    }
+}
+
+/// Checks measured per-order albedos against a reference row.
+fn check_orders(toml: &str, hemisphere: Hemisphere, reference: &[f64], ref_photons: f64, label: &str) {
+    let sim = simulate(toml, 2);
+    let d = mono(&sim, 0);
+    for (k, &r) in reference.iter().enumerate() {
+        // Slot 0 is all orders; a reference row starts at slot `first`.
+        let (e, se) = albedo(d, k + 1, hemisphere);
+        let se_ref = (r * (1.0 - r) / ref_photons).sqrt();
+        let rounding = 5e-5 / 3f64.sqrt();
+        let tol = 4.0 * (se * se + se_ref * se_ref + rounding * rounding).sqrt();
+        assert!((e - r).abs() <= tol, "{label} E{}: {e:.5} +- {se:.5}, reference {r} (tol {tol:.5})", k + 1);
+    }
+}
+
+#[test]
+fn conductor_per_order_albedos() {
+    // §9.4: conductor F = 1, isotropic GGX, uniform heights; E1..E6.
+    let table: [(f64, f64, [f64; 6]); 8] = [
+        (0.5, 0.0, [0.6883, 0.2316, 0.0642, 0.0135, 0.0021, 0.0003]),
+        (0.5, 30.0, [0.6821, 0.2396, 0.0636, 0.0125, 0.0020, 0.0002]),
+        (0.5, 60.0, [0.6982, 0.2400, 0.0524, 0.0083, 0.0010, 0.0001]),
+        (0.5, 80.0, [0.8057, 0.1711, 0.0212, 0.0019, 0.0001, 0.0000]),
+        (1.0, 0.0, [0.3069, 0.3225, 0.2110, 0.1025, 0.0397, 0.0127]),
+        (1.0, 30.0, [0.3347, 0.3284, 0.2009, 0.0904, 0.0325, 0.0098]),
+        (1.0, 60.0, [0.4509, 0.3307, 0.1506, 0.0506, 0.0135, 0.0030]),
+        (1.0, 80.0, [0.6681, 0.2585, 0.0612, 0.0105, 0.0015, 0.0002]),
+    ];
+    for (i, (alpha, theta, row)) in table.into_iter().enumerate() {
+        let toml = format!(
+            "paths = 2_000_000\nseed = {}\n[surface]\nalpha = {alpha}\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 8\n",
+            300 + i
+        );
+        check_orders(&toml, Hemisphere::R, &row, 2e6, &format!("conductor alpha {alpha} theta {theta}"));
+    }
+}
+
+#[test]
+fn lambertian_per_order_albedos() {
+    // §9.4: Lambertian facets rho = 1, isotropic GGX; E1..E5.
+    let table: [(f64, f64, [f64; 5]); 4] = [
+        (0.5, 0.0, [0.7801, 0.1327, 0.0536, 0.0201, 0.0080]),
+        (0.5, 60.0, [0.7554, 0.1534, 0.0569, 0.0208, 0.0079]),
+        (1.0, 0.0, [0.5825, 0.1765, 0.0999, 0.0556, 0.0327]),
+        (1.0, 60.0, [0.5649, 0.2028, 0.1026, 0.0543, 0.0304]),
+    ];
+    for (i, (alpha, theta, row)) in table.into_iter().enumerate() {
+        let toml = format!(
+            "paths = 1_000_000\nseed = {}\n[surface]\nalpha = {alpha}\n[material]\nkind = \"diffuse\"\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 8\n",
+            400 + i
+        );
+        check_orders(&toml, Hemisphere::R, &row, 1e6, &format!("lambertian alpha {alpha} theta {theta}"));
+    }
+}
+
+#[test]
+fn dielectric_reflection_and_transmission() {
+    // §9.4: eta 1.5, isotropic GGX alpha 0.5, exact Fresnel; light from outside and inside.
+    // (side, theta, R, T, R1, T1)
+    let table = [
+        ("outside", 0.0, 0.0298, 0.9702, 0.0279, 0.9404),
+        ("outside", 60.0, 0.0484, 0.9516, 0.0438, 0.8331),
+        ("inside", 0.0, 0.2361, 0.7639, 0.0463, 0.7071),
+        ("inside", 40.0, 0.5042, 0.4958, 0.2466, 0.4481),
+    ];
+    for (i, (side, theta, r, t, r1, t1)) in table.into_iter().enumerate() {
+        let toml = format!(
+            "paths = 1_000_000\nseed = {}\n[surface]\nalpha = 0.5\n[material]\nkind = \"dielectric\"\neta = 1.5\n[incident]\ntheta_deg = {theta}\nside = \"{side}\"\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 4\n",
+            500 + i
+        );
+        let sim = simulate(&toml, 2);
+        let d = mono(&sim, 0);
+        let rounding = 5e-5 / 3f64.sqrt();
+        for (slot, h, reference) in [(0, Hemisphere::R, r), (0, Hemisphere::T, t), (1, Hemisphere::R, r1), (1, Hemisphere::T, t1)] {
+            let (e, se) = albedo(d, slot, h);
+            let se_ref = (reference * (1.0 - reference) / 1e6).sqrt();
+            let tol = 4.0 * (se * se + se_ref * se_ref + rounding * rounding).sqrt();
+            assert!((e - reference).abs() <= tol, "{side} {theta}: slot {slot} {h:?} = {e:.5} +- {se:.5}, reference {reference}");
+        }
+    }
+}
+
+#[test]
+fn constant_fresnel_and_albedo_scale_each_order() {
+    // §9.1 scaling: with Schlick F0 = 1 everywhere F = 1; with diffuse albedo rho, f_k scales as
+    // rho^k. Same seed, so rho = 0.5 without roulette reweights the same paths exactly.
+    let run = |albedo: f64| {
+        let toml = format!(
+            "paths = 100_000\nseed = 8\n[surface]\nalpha = 0.7\n[material]\nkind = \"diffuse\"\nalbedo = {albedo}\n[incident]\ntheta_deg = 40\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 5\n[energy]\nsplit = false\nthreshold = 0.0\n"
+        );
+        simulate(&toml, 1)
+    };
+    let (one, half) = (run(1.0), run(0.5));
+    for k in 1..5 {
+        let (a, _) = albedo(mono(&one, 0), k, Hemisphere::R);
+        let (b, _) = albedo(mono(&half, 0), k, Hemisphere::R);
+        assert!((b - a * 0.5f64.powi(k as i32)).abs() < 1e-12, "order {k}: {b} vs {a} * 0.5^{k}");
+    }
+}

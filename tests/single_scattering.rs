@@ -1,0 +1,121 @@
+//! Order 1 of the walk against exact single scattering (THEORY.md §5): this is the test that
+//! proves the walk.
+//!
+//! * Histograms: for each case below, 10^6 photons on a 16 x 32 grid; the expected energy of
+//!   every bin is the single-scattering lobe integrated over the bin by adaptive quadrature
+//!   (`models::single_scattering_bins`). Per-bin variances come from the per-photon second
+//!   moments (weighted histograms); cells with an expected count below 5 are pooled. Each
+//!   chi-square test runs at the Sidak level keeping the family (all 8 tests) at 0.01.
+//! * Albedo: at 10^7 photons the order-1 albedo of the GGX conductor with F = 1 is compared
+//!   with the quadrature values of THEORY.md §9.4 (independent scripts; 1 - ln 2 in closed
+//!   form at alpha 1, normal incidence), within 4 standard errors (SE about 1.5e-4).
+
+mod common;
+
+use common::{albedo, mono, simulate, weighted_bins};
+use smithwalk::detector::Hemisphere;
+use smithwalk::models::single_scattering_bins;
+use smithwalk::stats::{chi_square, sidak};
+
+struct HistogramCase {
+    surface: &'static str,
+    material: &'static str,
+    theta: f64,
+    phi: f64,
+    hemispheres: &'static [Hemisphere],
+}
+
+const CASES: [HistogramCase; 6] = [
+    HistogramCase { surface: "ndf = \"ggx\"\nalpha = 0.5", material: "kind = \"conductor\"", theta: 30.0, phi: 0.0, hemispheres: &[Hemisphere::R] },
+    HistogramCase {
+        surface: "ndf = \"beckmann\"\nalpha = 0.3",
+        material: "kind = \"conductor\"\nfresnel = \"exact\"\neta = 0.2\nk = 3.0",
+        theta: 60.0,
+        phi: 0.0,
+        hemispheres: &[Hemisphere::R],
+    },
+    HistogramCase {
+        surface: "ndf = \"ggx\"\nalpha = [[0.5, 0.2]]",
+        material: "kind = \"conductor\"\nfresnel = \"exact\"\neta = 2.8\nk = 3.7",
+        theta: 45.0,
+        phi: 30.0,
+        hemispheres: &[Hemisphere::R],
+    },
+    HistogramCase { surface: "ndf = \"ggx\"\nalpha = 1.0", material: "kind = \"conductor\"", theta: 80.0, phi: 0.0, hemispheres: &[Hemisphere::R] },
+    HistogramCase {
+        surface: "ndf = \"ggx\"\nalpha = 0.5",
+        material: "kind = \"dielectric\"\neta = 1.5",
+        theta: 30.0,
+        phi: 0.0,
+        hemispheres: &[Hemisphere::R, Hemisphere::T],
+    },
+    HistogramCase {
+        surface: "ndf = \"beckmann\"\nalpha = 0.4",
+        material: "kind = \"dielectric\"\neta = 1.5",
+        theta: 70.0,
+        phi: 120.0,
+        hemispheres: &[Hemisphere::R, Hemisphere::T],
+    },
+];
+
+#[test]
+fn order_one_histograms_match_single_scattering() {
+    let tests: usize = CASES.iter().map(|c| c.hemispheres.len()).sum();
+    let level = sidak(0.01, tests);
+    for (i, c) in CASES.iter().enumerate() {
+        let toml = format!(
+            "paths = 1_000_000\nseed = {seed}\n[surface]\n{}\n[material]\n{}\n[incident]\ntheta_deg = {}\nphi_deg = {}\n[detector]\ncos_theta_bins = 16\nphi_bins = 32\nmax_order = 2\n",
+            c.surface,
+            c.material,
+            c.theta,
+            c.phi,
+            seed = 100 + i
+        );
+        let sim = simulate(&toml, 2);
+        let d = mono(&sim, 0);
+        for &h in c.hemispheres {
+            let expected = single_scattering_bins(&sim.cases[0], &d.grid, h, 1e-10).expect("closed form applies");
+            let test = chi_square(&weighted_bins(d, 1, h), &expected, d.photons, 5.0);
+            assert!(
+                test.p_value > level,
+                "case {i} ({} / {} at {} deg) {h:?}: order-1 histogram rejected\n{}",
+                c.surface,
+                c.material,
+                c.theta,
+                test.worst_cells(12)
+            );
+        }
+    }
+}
+
+#[test]
+fn order_one_albedo_matches_quadrature() {
+    // (alpha, theta_i, E1 from THEORY.md §9.4 quadrature)
+    let refs = [(1.0, 0.0, 1.0 - std::f64::consts::LN_2), (1.0, 60.0, 0.450694), (0.5, 0.0, 0.687849)];
+    for (i, (alpha, theta, e1)) in refs.into_iter().enumerate() {
+        let toml = format!(
+            "paths = 10_000_000\nseed = {}\n[surface]\nalpha = {alpha}\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 2\n",
+            200 + i
+        );
+        let sim = simulate(&toml, 2);
+        let (e, se) = albedo(mono(&sim, 0), 1, Hemisphere::R);
+        println!("alpha {alpha} theta {theta}: E1 = {e:.5} +- {se:.5}, quadrature {e1:.5}, diff {:.2} SE", (e - e1) / se);
+        assert!(se < 1.6e-4, "SE {se}");
+        assert!((e - e1).abs() < 4.0 * se, "alpha {alpha} theta {theta}: E1 = {e} +- {se}, expected {e1}");
+    }
+}
+
+#[test]
+fn a_wrong_lobe_is_rejected() {
+    // The histogram test must have power: the alpha = 0.5 histogram against the alpha = 0.55
+    // single-scattering expectation is rejected.
+    let toml = "paths = 1_000_000\nseed = 9\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 30\n[detector]\ncos_theta_bins = 16\nphi_bins = 32\nmax_order = 2\n";
+    let sim = simulate(toml, 2);
+    let mut other = sim.cases[0].clone();
+    other.alpha_x = 0.55;
+    other.alpha_y = 0.55;
+    let d = mono(&sim, 0);
+    let expected = single_scattering_bins(&other, &d.grid, Hemisphere::R, 1e-10).unwrap();
+    let test = chi_square(&weighted_bins(d, 1, Hemisphere::R), &expected, d.photons, 5.0);
+    assert!(test.p_value < 1e-6, "p = {}", test.p_value);
+}
