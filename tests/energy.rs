@@ -48,10 +48,9 @@ fn check_orders(toml: &str, hemisphere: Hemisphere, reference: &[f64], ref_photo
     let sim = simulate(toml, 2);
     let d = mono(&sim, 0);
     for (k, &r) in reference.iter().enumerate() {
-        // Slot 0 is all orders; a reference row starts at slot `first`.
         let (e, se) = albedo(d, k + 1, hemisphere);
         let se_ref = (r * (1.0 - r) / ref_photons).sqrt();
-        let rounding = 5e-5 / 3f64.sqrt();
+        let rounding: f64 = 5e-5 / 3f64.sqrt();
         let tol = 4.0 * (se * se + se_ref * se_ref + rounding * rounding).sqrt();
         assert!((e - r).abs() <= tol, "{label} E{}: {e:.5} +- {se:.5}, reference {r} (tol {tol:.5})", k + 1);
     }
@@ -114,8 +113,8 @@ fn dielectric_reflection_and_transmission() {
         );
         let sim = simulate(&toml, 2);
         let d = mono(&sim, 0);
-        let rounding = 5e-5 / 3f64.sqrt();
-        for (slot, h, reference) in [(0, Hemisphere::R, r), (0, Hemisphere::T, t), (1, Hemisphere::R, r1), (1, Hemisphere::T, t1)] {
+        let rounding: f64 = 5e-5 / 3f64.sqrt();
+        for (slot, h, reference) in [(0, Hemisphere::R, r as f64), (0, Hemisphere::T, t), (1, Hemisphere::R, r1), (1, Hemisphere::T, t1)] {
             let (e, se) = albedo(d, slot, h);
             let se_ref = (reference * (1.0 - reference) / 1e6).sqrt();
             let tol = 4.0 * (se * se + se_ref * se_ref + rounding * rounding).sqrt();

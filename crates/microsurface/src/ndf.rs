@@ -147,11 +147,13 @@ pub struct Beckmann(pub Roughness);
 
 /// Beckmann Lambda for `a = w_z / (alpha_i sqrt(1 - w_z^2)) > 0` (§1.4), written with erfc so that
 /// `erf(a) - 1` does not cancel (§10): `Lambda = (e^{-a^2} / (a sqrt(pi)) - erfc(a)) / 2`.
+/// Near `a = 27` both terms are subnormal and their rounded difference can come out negative;
+/// Lambda is clamped at 0 there (a negative extinction rate would send rays to infinite depth).
 fn beckmann_lambda_above(a: f64) -> f64 {
     if a.is_infinite() {
         return 0.0;
     }
-    0.5 * ((-a * a).exp() / (a * SQRT_PI) - erfc(a))
+    (0.5 * ((-a * a).exp() / (a * SQRT_PI) - erfc(a))).max(0.0)
 }
 
 impl Beckmann {
