@@ -44,7 +44,13 @@ fn to_fixed(x: f64) -> i128 {
     let mantissa = ((bits & ((1u64 << 52) - 1)) | (1u64 << 52)) as i128;
     // x = mantissa * 2^(exponent - 1075); scaled by 2^64.
     let shift = exponent - 1075 + 64;
-    if shift >= 0 { mantissa << shift.min(73) } else if shift > -64 { mantissa >> -shift } else { 0 }
+    if shift >= 0 {
+        mantissa << shift.min(73)
+    } else if shift > -64 {
+        mantissa >> -shift
+    } else {
+        0
+    }
 }
 
 /// Sum, sum of squares (per photon) and number of photons of one quantity, per channel.
@@ -57,7 +63,11 @@ pub struct Tally<const C: usize> {
 
 impl<const C: usize> Default for Tally<C> {
     fn default() -> Self {
-        Self { sum: [Fixed::default(); C], sum_sq: [Fixed::default(); C], count: 0 }
+        Self {
+            sum: [Fixed::default(); C],
+            sum_sq: [Fixed::default(); C],
+            count: 0,
+        }
     }
 }
 
@@ -114,13 +124,17 @@ impl Grid {
         if phi < 0.0 {
             phi += std::f64::consts::TAU;
         }
-        let ip = ((phi * (self.phi_bins as f64 / std::f64::consts::TAU)) as usize).min(self.phi_bins - 1);
+        let ip = ((phi * (self.phi_bins as f64 / std::f64::consts::TAU)) as usize)
+            .min(self.phi_bins - 1);
         ic * self.phi_bins + ip
     }
 
     /// `[|cos| lo, |cos| hi]` of a cos index.
     pub fn cos_edges(&self, ic: usize) -> (f64, f64) {
-        (ic as f64 / self.cos_bins as f64, (ic + 1) as f64 / self.cos_bins as f64)
+        (
+            ic as f64 / self.cos_bins as f64,
+            (ic + 1) as f64 / self.cos_bins as f64,
+        )
     }
 
     /// `[phi lo, phi hi]` in degrees of a phi index.
@@ -156,7 +170,10 @@ pub struct OrderTallies<const C: usize> {
 
 impl<const C: usize> OrderTallies<C> {
     fn new(grid: &Grid) -> Self {
-        Self { bins: vec![Tally::default(); 2 * grid.bins()], albedo: [Tally::default(); 2] }
+        Self {
+            bins: vec![Tally::default(); 2 * grid.bins()],
+            albedo: [Tally::default(); 2],
+        }
     }
 
     fn merge(&mut self, other: &Self) {
@@ -209,11 +226,19 @@ impl<const C: usize> Detector<C> {
     /// A detector for light arriving from `wi` (towards the light).
     pub fn new(grid: Grid, wi: DVec3, max_order: Option<u32>) -> Self {
         let horizontal = wi.x.hypot(wi.y);
-        let rotation = if horizontal > 0.0 { (wi.x / horizontal, wi.y / horizontal) } else { (1.0, 0.0) };
+        let rotation = if horizontal > 0.0 {
+            (wi.x / horizontal, wi.y / horizontal)
+        } else {
+            (1.0, 0.0)
+        };
         Self {
             grid,
             rotation,
-            incident_side: if wi.z >= 0.0 { Side::Outside } else { Side::Inside },
+            incident_side: if wi.z >= 0.0 {
+                Side::Outside
+            } else {
+                Side::Inside
+            },
             max_order,
             orders: vec![OrderTallies::new(&grid)],
             accounted: Tally::default(),
@@ -284,7 +309,8 @@ impl<const C: usize> Detector<C> {
     /// per (slot, hemisphere) before squaring, so variances stay per photon (§4.6).
     fn add_split_photon(&mut self) {
         let bins = self.grid.bins();
-        let mut keyed: Vec<(usize, usize, usize, [f64; C])> = Vec::with_capacity(2 * self.pending.len());
+        let mut keyed: Vec<(usize, usize, usize, [f64; C])> =
+            Vec::with_capacity(2 * self.pending.len());
         for d in &self.pending {
             let i = d.hemisphere as usize * bins + d.bin;
             keyed.push((0, d.hemisphere as usize, i, d.weight));
@@ -329,9 +355,18 @@ impl<const C: usize> Detector<C> {
 impl<const C: usize> Observer<C> for Detector<C> {
     #[inline]
     fn escape(&mut self, order: u32, side: Side, dir: DVec3, weight: &[f64; C]) {
-        let hemisphere = if side == self.incident_side { Hemisphere::R } else { Hemisphere::T };
+        let hemisphere = if side == self.incident_side {
+            Hemisphere::R
+        } else {
+            Hemisphere::T
+        };
         let bin = self.grid.bin(dir, self.rotation);
-        self.pending.push(Deposit { slot: self.slot(order), hemisphere, bin, weight: *weight });
+        self.pending.push(Deposit {
+            slot: self.slot(order),
+            hemisphere,
+            bin,
+            weight: *weight,
+        });
     }
 
     fn lose(&mut self, loss: Loss, weight: &[f64; C]) {

@@ -9,7 +9,10 @@ use smithwalk::config::Config;
 use smithwalk::output::{EnergyBalance, prepare_dir};
 
 #[derive(Parser)]
-#[command(version, about = "A virtual gonioreflectometer for the Smith microsurface")]
+#[command(
+    version,
+    about = "A virtual gonioreflectometer for the Smith microsurface"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -36,7 +39,13 @@ enum Command {
     },
 }
 
-fn run(config_path: PathBuf, paths: Option<u64>, seed: Option<u64>, threads: Option<usize>, out: Option<PathBuf>) -> Result<()> {
+fn run(
+    config_path: PathBuf,
+    paths: Option<u64>,
+    seed: Option<u64>,
+    threads: Option<usize>,
+    out: Option<PathBuf>,
+) -> Result<()> {
     let mut config = Config::load(&config_path)?;
     if let Some(p) = paths {
         config.paths = p;
@@ -49,7 +58,11 @@ fn run(config_path: PathBuf, paths: Option<u64>, seed: Option<u64>, threads: Opt
         anyhow::bail!("`--threads` = 0 is not allowed: at least 1 thread");
     }
     let out = out.unwrap_or_else(|| {
-        PathBuf::from("out").join(config_path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()))
+        PathBuf::from("out").join(
+            config_path
+                .file_stem()
+                .map_or("run".into(), |s| s.to_string_lossy().into_owned()),
+        )
     });
     prepare_dir(&out)?;
     let sim = smithwalk::simulate(&config, threads, true)?;
@@ -64,12 +77,19 @@ fn run(config_path: PathBuf, paths: Option<u64>, seed: Option<u64>, threads: Opt
         total as f64 / sim.wall_seconds,
         total as f64 / sim.wall_seconds / sim.threads as f64
     );
-    println!("{:>5}  {:<44} {:>9} {:>9} {:>9} {:>9} {:>6}", "case", "surface / material / incidence", "R", "T", "absorbed", "lost", "orders");
+    println!(
+        "{:>5}  {:<44} {:>9} {:>9} {:>9} {:>9} {:>6}",
+        "case", "surface / material / incidence", "R", "T", "absorbed", "lost", "orders"
+    );
     for (case, result) in sim.cases.iter().zip(&sim.results) {
         let e = EnergyBalance::from_result(result);
         let label = format!(
             "{:?} a=({},{}) {} th={}",
-            case.ndf, case.alpha_x, case.alpha_y, case.material.label(), case.theta_i_deg
+            case.ndf,
+            case.alpha_x,
+            case.alpha_y,
+            case.material.label(),
+            case.theta_i_deg
         );
         println!(
             "{:>5}  {:<44} {:>9.6} {:>9.6} {:>9.6} {:>9.2e} {:>6}",
@@ -91,7 +111,13 @@ fn run(config_path: PathBuf, paths: Option<u64>, seed: Option<u64>, threads: Opt
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { config, paths, seed, threads, out } => run(config, paths, seed, threads, out),
+        Command::Run {
+            config,
+            paths,
+            seed,
+            threads,
+            out,
+        } => run(config, paths, seed, threads, out),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -64,7 +64,11 @@ fn hemisphere_sign(side: IncidentSide, hemisphere: Hemisphere) -> f64 {
 }
 
 fn hemispheres(case: &Case) -> &'static [Hemisphere] {
-    if case.material.transmits() { &[Hemisphere::R, Hemisphere::T] } else { &[Hemisphere::R] }
+    if case.material.transmits() {
+        &[Hemisphere::R, Hemisphere::T]
+    } else {
+        &[Hemisphere::R]
+    }
 }
 
 /// Energy accounting of one case, per channel (§9.2).
@@ -102,7 +106,11 @@ impl EnergyBalance {
             lost_invalid: per_channel::<C>(|c| mean(&d.lost[1], c)),
             lost_runaway: per_channel::<C>(|c| mean(&d.lost[2], c)),
             folded: per_channel::<C>(|c| {
-                if d.is_folded(last) { mean(&d.orders[last].albedo[0], c) + mean(&d.orders[last].albedo[1], c) } else { 0.0 }
+                if d.is_folded(last) {
+                    mean(&d.orders[last].albedo[0], c) + mean(&d.orders[last].albedo[1], c)
+                } else {
+                    0.0
+                }
             }),
             highest_order: last,
         }
@@ -116,7 +124,11 @@ impl EnergyBalance {
     }
 
     pub fn lost(&self) -> f64 {
-        self.lost_trapped.iter().chain(&self.lost_invalid).chain(&self.lost_runaway).sum()
+        self.lost_trapped
+            .iter()
+            .chain(&self.lost_invalid)
+            .chain(&self.lost_runaway)
+            .sum()
     }
 }
 
@@ -124,7 +136,11 @@ fn channel_header(rgb: bool) -> Vec<&'static str> {
     if rgb { vec!["channel"] } else { vec![] }
 }
 
-fn lobe_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Detector<C>) -> Result<()> {
+fn lobe_rows<const C: usize>(
+    w: &mut csv::Writer<Vec<u8>>,
+    case: &Case,
+    d: &Detector<C>,
+) -> Result<()> {
     let fields = case_fields(case);
     let grid = d.grid;
     let n = d.photons;
@@ -137,7 +153,8 @@ fn lobe_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Dete
                 let solid = grid.projected_solid_angle(ic);
                 for ip in 0..grid.phi_bins {
                     let (phi_lo, phi_hi) = grid.phi_edges_deg(ip);
-                    let tally = &tallies.bins[hemisphere as usize * grid.bins() + ic * grid.phi_bins + ip];
+                    let tally =
+                        &tallies.bins[hemisphere as usize * grid.bins() + ic * grid.phi_bins + ip];
                     for c in 0..C {
                         let (energy, se) = tally.mean_and_stderr(n, c);
                         let mut row = fields.clone();
@@ -146,7 +163,9 @@ fn lobe_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Dete
                         if C > 1 {
                             row.push(CHANNEL_NAMES[c].to_string());
                         }
-                        row.extend([cos_lo, cos_hi, phi_lo, phi_hi, energy, se].map(|v| v.to_string()));
+                        row.extend(
+                            [cos_lo, cos_hi, phi_lo, phi_hi, energy, se].map(|v| v.to_string()),
+                        );
                         row.push(tally.count.to_string());
                         row.push((energy / solid).to_string());
                         row.push((se / solid).to_string());
@@ -159,7 +178,11 @@ fn lobe_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Dete
     Ok(())
 }
 
-fn summary_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Detector<C>) -> Result<()> {
+fn summary_rows<const C: usize>(
+    w: &mut csv::Writer<Vec<u8>>,
+    case: &Case,
+    d: &Detector<C>,
+) -> Result<()> {
     let fields = case_fields(case);
     let n = d.photons;
     let mut write = |order: usize, what: &str, c: usize, value: f64, se: f64, folded: bool| {
@@ -177,7 +200,14 @@ fn summary_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &D
         for &hemisphere in hemispheres(case) {
             for c in 0..C {
                 let (albedo, se) = tallies.albedo[hemisphere as usize].mean_and_stderr(n, c);
-                write(slot, &format!("{hemisphere:?}"), c, albedo, se, d.is_folded(slot))?;
+                write(
+                    slot,
+                    &format!("{hemisphere:?}"),
+                    c,
+                    albedo,
+                    se,
+                    d.is_folded(slot),
+                )?;
             }
         }
     }
@@ -185,7 +215,12 @@ fn summary_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &D
         let (accounted, se) = d.accounted.mean_and_stderr(n, c);
         write(0, "absorbed", c, 1.0 - accounted, se, false)?;
         let lost: f64 = d.lost.iter().map(|t| t.mean_and_stderr(n, c).0).sum();
-        let lost_se = d.lost.iter().map(|t| t.mean_and_stderr(n, c).1.powi(2)).sum::<f64>().sqrt();
+        let lost_se = d
+            .lost
+            .iter()
+            .map(|t| t.mean_and_stderr(n, c).1.powi(2))
+            .sum::<f64>()
+            .sqrt();
         write(0, "lost", c, lost, lost_se, false)?;
     }
     Ok(())
@@ -197,7 +232,17 @@ pub fn lobes_csv(sim: &Simulation) -> Result<Vec<u8>> {
     let mut header: Vec<&str> = CASE_COLUMNS.to_vec();
     header.extend(["order", "hemisphere"]);
     header.extend(channel_header(sim.rgb));
-    header.extend(["cos_lo", "cos_hi", "phi_lo_deg", "phi_hi_deg", "energy", "energy_stderr", "count", "bsdf", "bsdf_stderr"]);
+    header.extend([
+        "cos_lo",
+        "cos_hi",
+        "phi_lo_deg",
+        "phi_hi_deg",
+        "energy",
+        "energy_stderr",
+        "count",
+        "bsdf",
+        "bsdf_stderr",
+    ]);
     w.write_record(&header)?;
     for (case, result) in sim.cases.iter().zip(&sim.results) {
         match result {
@@ -261,7 +306,10 @@ pub fn run_json(sim: &Simulation, config: &Config) -> Result<Vec<u8>> {
             .cases
             .iter()
             .zip(&sim.results)
-            .map(|(case, r)| CaseReport { case, energy: EnergyBalance::from_result(r) })
+            .map(|(case, r)| CaseReport {
+                case,
+                energy: EnergyBalance::from_result(r),
+            })
             .collect(),
     };
     let mut text = serde_json::to_vec_pretty(&report)?;
@@ -283,9 +331,18 @@ fn make_readable(_file: &std::fs::File) -> std::io::Result<()> {
 
 /// Makes sure `dir` exists and is writable, before any simulation time is spent.
 pub fn prepare_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("--out {}: cannot create the output directory", dir.display()))?;
-    tempfile::NamedTempFile::new_in(dir)
-        .with_context(|| format!("--out {}: the output directory is not writable", dir.display()))?;
+    std::fs::create_dir_all(dir).with_context(|| {
+        format!(
+            "--out {}: cannot create the output directory",
+            dir.display()
+        )
+    })?;
+    tempfile::NamedTempFile::new_in(dir).with_context(|| {
+        format!(
+            "--out {}: the output directory is not writable",
+            dir.display()
+        )
+    })?;
     Ok(())
 }
 
@@ -296,14 +353,19 @@ pub fn write_atomically(dir: &Path, files: &[(&str, Vec<u8>)]) -> Result<Vec<Pat
     for (file, bytes) in files {
         let mut tmp = tempfile::NamedTempFile::new_in(dir)
             .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
-        tmp.write_all(bytes).with_context(|| format!("cannot write {file}"))?;
-        make_readable(tmp.as_file()).with_context(|| format!("cannot set the permissions of {file}"))?;
-        tmp.as_file().sync_all().with_context(|| format!("cannot write {file}"))?;
+        tmp.write_all(bytes)
+            .with_context(|| format!("cannot write {file}"))?;
+        make_readable(tmp.as_file())
+            .with_context(|| format!("cannot set the permissions of {file}"))?;
+        tmp.as_file()
+            .sync_all()
+            .with_context(|| format!("cannot write {file}"))?;
         staged.push((tmp, dir.join(file)));
     }
     let mut written = Vec::new();
     for (tmp, path) in staged {
-        tmp.persist(&path).with_context(|| format!("cannot rename into {}", path.display()))?;
+        tmp.persist(&path)
+            .with_context(|| format!("cannot rename into {}", path.display()))?;
         written.push(path);
     }
     Ok(written)

@@ -6,7 +6,6 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use indicatif::ProgressBar;
 use microsurface::facet::{Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Lambertian};
-use microsurface::height::{GaussianHeight, HeightDistribution, UniformHeight};
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 use microsurface::normals::Normals;
 use microsurface::smith::Smith;
@@ -14,7 +13,7 @@ use microsurface::walk::{EnergyPolicy, Microsurface};
 use rand_pcg::Pcg64Mcg;
 
 use crate::cases::Case;
-use crate::config::{Config, FresnelKind, HeightKind, MaterialConfig, NdfKind, NormalsKind, SmithKind};
+use crate::config::{Config, FresnelKind, MaterialConfig, NdfKind, NormalsKind, SmithKind};
 use crate::detector::{Detector, Grid};
 
 /// Photons per chunk: the unit of work and of random streams. Part of the output's identity:
@@ -36,9 +35,15 @@ impl RunSettings {
         Self {
             paths: config.paths,
             seed: config.seed,
-            grid: Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins },
+            grid: Grid {
+                cos_bins: config.detector.cos_theta_bins,
+                phi_bins: config.detector.phi_bins,
+            },
             max_order: config.detector.max_order,
-            policy: EnergyPolicy { split: config.energy.split, threshold: config.energy.threshold },
+            policy: EnergyPolicy {
+                split: config.energy.split,
+                threshold: config.energy.threshold,
+            },
         }
     }
 
@@ -90,14 +95,21 @@ fn with_ndf<const C: usize>(
     pool: &rayon::ThreadPool,
     progress: &ProgressBar,
 ) -> Detector<C> {
-    let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
+    let roughness = Roughness {
+        x: case.alpha_x,
+        y: case.alpha_y,
+    };
     match case.ndf {
-        NdfKind::Ggx => with_height::<Ggx, C>(Ggx(roughness), case, settings, pool, progress),
-        NdfKind::Beckmann => with_height::<Beckmann, C>(Beckmann(roughness), case, settings, pool, progress),
+        NdfKind::Ggx => with_surface::<Ggx, C>(Ggx(roughness), case, settings, pool, progress),
+        NdfKind::Beckmann => {
+            with_surface::<Beckmann, C>(Beckmann(roughness), case, settings, pool, progress)
+        }
     }
 }
 
-fn with_height<N: Ndf, const C: usize>(
+/// Builds the microsurface of a case. The case's height distribution does not enter: the walk
+/// runs in optical depth, where every height law gives the same walk (THEORY.md §2.1, §2.4).
+fn with_surface<N: Ndf, const C: usize>(
     ndf: N,
     case: &Case,
     settings: &RunSettings,
@@ -112,55 +124,88 @@ fn with_height<N: Ndf, const C: usize>(
         NormalsKind::Vndf => Normals::Visible,
         NormalsKind::HammonRejection => Normals::HammonRejection,
     };
-    match case.height {
-        HeightKind::Uniform => {
-            let surface = Microsurface { ndf, heights: UniformHeight, smith, normals };
-            with_material(&surface, case, settings, pool, progress)
-        }
-        HeightKind::Gaussian => {
-            let surface = Microsurface { ndf, heights: GaussianHeight, smith, normals };
-            with_material(&surface, case, settings, pool, progress)
-        }
-    }
+    with_material(
+        &Microsurface {
+            ndf,
+            smith,
+            normals,
+        },
+        case,
+        settings,
+        pool,
+        progress,
+    )
 }
 
-fn with_material<N: Ndf, H: HeightDistribution, const C: usize>(
-    surface: &Microsurface<N, H>,
+fn with_material<N: Ndf, const C: usize>(
+    surface: &Microsurface<N>,
     case: &Case,
     settings: &RunSettings,
     pool: &rayon::ThreadPool,
     progress: &ProgressBar,
 ) -> Detector<C> {
     match &case.material {
-        MaterialConfig::Conductor { fresnel, f0, eta, k, .. } => {
+        MaterialConfig::Conductor {
+            fresnel,
+            f0,
+            eta,
+            k,
+            ..
+        } => {
             let fresnel = match fresnel {
                 FresnelKind::None => ConductorFresnel::None,
                 FresnelKind::Schlick => ConductorFresnel::Schlick { f0: channels(f0) },
-                FresnelKind::Exact => ConductorFresnel::Exact { eta: channels(eta), k: channels(k) },
+                FresnelKind::Exact => ConductorFresnel::Exact {
+                    eta: channels(eta),
+                    k: channels(k),
+                },
             };
-            run_chunks(surface, &Conductor { fresnel }, case, settings, pool, progress)
+            run_chunks(
+                surface,
+                &Conductor { fresnel },
+                case,
+                settings,
+                pool,
+                progress,
+            )
         }
-        MaterialConfig::Dielectric { eta, .. } => {
-            run_chunks(surface, &Dielectric { eta: *eta }, case, settings, pool, progress)
-        }
-        MaterialConfig::Diffuse { albedo, .. } => {
-            run_chunks(surface, &Lambertian { albedo: albedo.to_array() }, case, settings, pool, progress)
-        }
+        MaterialConfig::Dielectric { eta, .. } => run_chunks(
+            surface,
+            &Dielectric { eta: *eta },
+            case,
+            settings,
+            pool,
+            progress,
+        ),
+        MaterialConfig::Diffuse { albedo, .. } => run_chunks(
+            surface,
+            &Lambertian {
+                albedo: albedo.to_array(),
+            },
+            case,
+            settings,
+            pool,
+            progress,
+        ),
         MaterialConfig::Hammon { f0, albedo, .. } => {
-            let facet = Hammon { f0: f0.to_array(), albedo: albedo.to_array() };
+            let facet = Hammon {
+                f0: f0.to_array(),
+                albedo: albedo.to_array(),
+            };
             run_chunks(surface, &facet, case, settings, pool, progress)
         }
     }
 }
 
 fn channels<const C: usize>(c: &Option<crate::config::Channels>) -> [f64; C] {
-    c.expect("validated: the Fresnel mode's parameters are present").to_array()
+    c.expect("validated: the Fresnel mode's parameters are present")
+        .to_array()
 }
 
 /// Runs every chunk of a case on the pool: each worker takes the next chunk index from a
 /// shared counter and accumulates into its own detector; the detectors are merged at the end.
-fn run_chunks<N, H, F, const C: usize>(
-    surface: &Microsurface<N, H>,
+fn run_chunks<N, F, const C: usize>(
+    surface: &Microsurface<N>,
     facet: &F,
     case: &Case,
     settings: &RunSettings,
@@ -169,7 +214,6 @@ fn run_chunks<N, H, F, const C: usize>(
 ) -> Detector<C>
 where
     N: Ndf,
-    H: HeightDistribution,
     F: Facet<C>,
 {
     let wi = case.incident_direction();
@@ -186,14 +230,23 @@ where
             let photons = CHUNK.min(settings.paths - chunk * CHUNK);
             let mut rng = chunk_rng(settings.seed, case.index, chunk);
             for _ in 0..photons {
-                surface.trace(facet, &settings.policy, wi, &mut rng, &mut stack, &mut detector);
+                surface.trace(
+                    facet,
+                    &settings.policy,
+                    wi,
+                    &mut rng,
+                    &mut stack,
+                    &mut detector,
+                );
                 detector.end_photon();
             }
             progress.inc(photons);
         }
     });
     let mut partials = partials.into_iter();
-    let mut total = partials.next().unwrap_or_else(|| Detector::new(settings.grid, wi, settings.max_order));
+    let mut total = partials
+        .next()
+        .unwrap_or_else(|| Detector::new(settings.grid, wi, settings.max_order));
     for p in partials {
         total.merge(&p);
     }

@@ -30,12 +30,24 @@ fn white_furnace() {
         let sim = simulate(&toml, 2);
         for (case, result) in sim.cases.iter().zip(&sim.results) {
             let e = EnergyBalance::from_result(result);
-            let label = format!("{ndf} alpha=({},{}) {} theta={}", case.alpha_x, case.alpha_y, case.material.label(), case.theta_i_deg);
+            let label = format!(
+                "{ndf} alpha=({},{}) {} theta={}",
+                case.alpha_x,
+                case.alpha_y,
+                case.material.label(),
+                case.theta_i_deg
+            );
             assert_eq!(e.lost(), 0.0, "{label}: weight lost {e:?}");
             let (absorbed, se) = (e.absorbed[0], e.absorbed_stderr[0]);
-            assert!(absorbed.abs() <= 4.0 * se + 1e-12, "{label}: absorbed {absorbed} +- {se}");
+            assert!(
+                absorbed.abs() <= 4.0 * se + 1e-12,
+                "{label}: absorbed {absorbed} +- {se}"
+            );
             let r_plus_t = e.reflected[0] + e.transmitted[0];
-            assert!((r_plus_t - 1.0).abs() <= 4.0 * se + 1e-12, "{label}: R + T = {r_plus_t} +- {se}");
+            assert!(
+                (r_plus_t - 1.0).abs() <= 4.0 * se + 1e-12,
+                "{label}: R + T = {r_plus_t} +- {se}"
+            );
             if !case.material.transmits() {
                 assert_eq!(e.transmitted[0], 0.0, "{label}");
             }
@@ -44,7 +56,13 @@ fn white_furnace() {
 }
 
 /// Checks measured per-order albedos against a reference row.
-fn check_orders(toml: &str, hemisphere: Hemisphere, reference: &[f64], ref_photons: f64, label: &str) {
+fn check_orders(
+    toml: &str,
+    hemisphere: Hemisphere,
+    reference: &[f64],
+    ref_photons: f64,
+    label: &str,
+) {
     let sim = simulate(toml, 2);
     let d = mono(&sim, 0);
     for (k, &r) in reference.iter().enumerate() {
@@ -52,7 +70,11 @@ fn check_orders(toml: &str, hemisphere: Hemisphere, reference: &[f64], ref_photo
         let se_ref = (r * (1.0 - r) / ref_photons).sqrt();
         let rounding: f64 = 5e-5 / 3f64.sqrt();
         let tol = 4.0 * (se * se + se_ref * se_ref + rounding * rounding).sqrt();
-        assert!((e - r).abs() <= tol, "{label} E{}: {e:.5} +- {se:.5}, reference {r} (tol {tol:.5})", k + 1);
+        assert!(
+            (e - r).abs() <= tol,
+            "{label} E{}: {e:.5} +- {se:.5}, reference {r} (tol {tol:.5})",
+            k + 1
+        );
     }
 }
 
@@ -74,7 +96,13 @@ fn conductor_per_order_albedos() {
             "paths = 2_000_000\nseed = {}\n[surface]\nalpha = {alpha}\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 8\n",
             300 + i
         );
-        check_orders(&toml, Hemisphere::R, &row, 2e6, &format!("conductor alpha {alpha} theta {theta}"));
+        check_orders(
+            &toml,
+            Hemisphere::R,
+            &row,
+            2e6,
+            &format!("conductor alpha {alpha} theta {theta}"),
+        );
     }
 }
 
@@ -92,7 +120,13 @@ fn lambertian_per_order_albedos() {
             "paths = 1_000_000\nseed = {}\n[surface]\nalpha = {alpha}\n[material]\nkind = \"diffuse\"\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 8\n",
             400 + i
         );
-        check_orders(&toml, Hemisphere::R, &row, 1e6, &format!("lambertian alpha {alpha} theta {theta}"));
+        check_orders(
+            &toml,
+            Hemisphere::R,
+            &row,
+            1e6,
+            &format!("lambertian alpha {alpha} theta {theta}"),
+        );
     }
 }
 
@@ -114,11 +148,19 @@ fn dielectric_reflection_and_transmission() {
         let sim = simulate(&toml, 2);
         let d = mono(&sim, 0);
         let rounding: f64 = 5e-5 / 3f64.sqrt();
-        for (slot, h, reference) in [(0, Hemisphere::R, r as f64), (0, Hemisphere::T, t), (1, Hemisphere::R, r1), (1, Hemisphere::T, t1)] {
+        for (slot, h, reference) in [
+            (0, Hemisphere::R, r as f64),
+            (0, Hemisphere::T, t),
+            (1, Hemisphere::R, r1),
+            (1, Hemisphere::T, t1),
+        ] {
             let (e, se) = albedo(d, slot, h);
             let se_ref = (reference * (1.0 - reference) / 1e6).sqrt();
             let tol = 4.0 * (se * se + se_ref * se_ref + rounding * rounding).sqrt();
-            assert!((e - reference).abs() <= tol, "{side} {theta}: slot {slot} {h:?} = {e:.5} +- {se:.5}, reference {reference}");
+            assert!(
+                (e - reference).abs() <= tol,
+                "{side} {theta}: slot {slot} {h:?} = {e:.5} +- {se:.5}, reference {reference}"
+            );
         }
     }
 }
@@ -137,6 +179,9 @@ fn constant_fresnel_and_albedo_scale_each_order() {
     for k in 1..5 {
         let (a, _) = albedo(mono(&one, 0), k, Hemisphere::R);
         let (b, _) = albedo(mono(&half, 0), k, Hemisphere::R);
-        assert!((b - a * 0.5f64.powi(k as i32)).abs() < 1e-12, "order {k}: {b} vs {a} * 0.5^{k}");
+        assert!(
+            (b - a * 0.5f64.powi(k as i32)).abs() < 1e-12,
+            "order {k}: {b} vs {a} * 0.5^{k}"
+        );
     }
 }

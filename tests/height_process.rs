@@ -5,12 +5,13 @@
 //! `P(u' <= x | hit) = (1 - (u/x)^Lambda) / (1 - u^Lambda)` upward and `(x/u)^lambda` downward
 //! (§2.3). Each check uses 200 000 flights: escapes by a two-sided binomial z test, next
 //! heights by a chi-square over 20 equiprobable bins (expected count 10 000 each, no pooling);
-//! all at the Sidak level that keeps the family at 0.01. Heights are converted back to `u`
-//! with independent closed forms (uniform: `(h+1)/2`; Gaussian: statrs' normal CDF), so the
-//! depth/height conversions of both distributions are tested too.
+//! all at the Sidak level that keeps the family at 0.01. The walk runs in optical depth
+//! `tau = -ln u` (§2.4); `u` is the height's CDF value, so for uniform heights on [-1, 1] the
+//! height is `2u - 1` and for Gaussian heights `Phi^{-1}(u)`: the law of `u` is the law of the
+//! height for every height distribution (§2.1).
 
 use microsurface::DVec3;
-use microsurface::height::{Flight, GaussianHeight, HeightDistribution, UniformHeight, fly};
+use microsurface::height::{Flight, fly, other_side_depth};
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 use microsurface::random::exp1;
 use microsurface::smith::Smith;
@@ -27,14 +28,6 @@ fn dir(theta_deg: f64, phi_deg: f64) -> DVec3 {
     DVec3::new(st * cp, st * sp, ct)
 }
 
-/// `u = C1(h)` by an independent formula.
-fn cdf_uniform(h: f64) -> f64 {
-    (h + 1.0) / 2.0
-}
-fn cdf_gaussian(h: f64) -> f64 {
-    Normal::standard().cdf(h)
-}
-
 /// Standard normal two-sided critical value for level `a`.
 fn z_critical(a: f64) -> f64 {
     Normal::standard().inverse_cdf(1.0 - a / 2.0)
@@ -47,33 +40,53 @@ struct Check {
 }
 
 const CHECKS: [Check; 6] = [
-    Check { u: 0.3, theta: 20.0, phi: 0.0 },
-    Check { u: 0.8, theta: 70.0, phi: 45.0 },
-    Check { u: 0.95, theta: 88.0, phi: 120.0 },
-    Check { u: 0.5, theta: 110.0, phi: 10.0 },
-    Check { u: 0.9, theta: 160.0, phi: 200.0 },
-    Check { u: 0.2, theta: 92.0, phi: 300.0 },
+    Check {
+        u: 0.3,
+        theta: 20.0,
+        phi: 0.0,
+    },
+    Check {
+        u: 0.8,
+        theta: 70.0,
+        phi: 45.0,
+    },
+    Check {
+        u: 0.95,
+        theta: 88.0,
+        phi: 120.0,
+    },
+    Check {
+        u: 0.5,
+        theta: 110.0,
+        phi: 10.0,
+    },
+    Check {
+        u: 0.9,
+        theta: 160.0,
+        phi: 200.0,
+    },
+    Check {
+        u: 0.2,
+        theta: 92.0,
+        phi: 300.0,
+    },
 ];
 
-fn run<N: Ndf, H: HeightDistribution>(ndf: &N, heights: H, cdf: fn(f64) -> f64, seed: u128, level: f64) {
+fn run<N: Ndf>(ndf: &N, seed: u128, level: f64) {
     let z_crit = z_critical(level);
     for (i, c) in CHECKS.iter().enumerate() {
         let d = dir(c.theta, c.phi);
         let rate = Smith::Exact.rate(ndf, d);
         let lambda = ndf.lambda(d);
         let up = d.z > 0.0;
-        // Place the ray at height h with C1(h) = u, through the distribution under test.
-        let h = heights.height(-c.u.ln());
-        // statrs' erfc_inv is accurate to about 1e-11 here; far below the test's resolution.
-        assert!((cdf(h) - c.u).abs() < 1e-9, "height({}) inverts to {}", c.u, cdf(h));
-        let tau = heights.depth(h);
+        let tau = -c.u.ln();
         let mut rng = Pcg64Mcg::new(seed + i as u128);
         let mut escapes = 0u64;
         let mut next = Vec::new();
         for _ in 0..FLIGHTS {
             match fly(tau, up, rate, exp1(&mut rng)) {
                 Flight::Escape => escapes += 1,
-                Flight::Hit(t) => next.push(cdf(heights.height(t))),
+                Flight::Hit(t) => next.push((-t).exp()),
             }
         }
         let label = format!("u={} theta={} phi={}", c.u, c.theta, c.phi);
@@ -82,7 +95,11 @@ fn run<N: Ndf, H: HeightDistribution>(ndf: &N, heights: H, cdf: fn(f64) -> f64, 
         if up {
             let n = FLIGHTS as f64;
             let z = (escapes as f64 - n * p) / (n * p * (1.0 - p)).sqrt();
-            assert!(z.abs() < z_crit, "{label}: {escapes} escapes, expected {:.1}, z = {z:.2}", n * p);
+            assert!(
+                z.abs() < z_crit,
+                "{label}: {escapes} escapes, expected {:.1}, z = {z:.2}",
+                n * p
+            );
         } else {
             assert_eq!(escapes, 0, "{label}: a downward ray escaped");
         }
@@ -96,28 +113,42 @@ fn run<N: Ndf, H: HeightDistribution>(ndf: &N, heights: H, cdf: fn(f64) -> f64, 
                 c.u * q.powf(1.0 / rate)
             }
         };
-        let edges: Vec<f64> = (0..=BINS).map(|k| quantile(k as f64 / BINS as f64)).collect();
+        let edges: Vec<f64> = (0..=BINS)
+            .map(|k| quantile(k as f64 / BINS as f64))
+            .collect();
         let mut counts = vec![0u64; BINS];
         for x in &next {
             let k = edges.partition_point(|e| e <= x).clamp(1, BINS) - 1;
             counts[k] += 1;
         }
         let hits = next.len() as f64;
-        let observed: Vec<WeightedBin> =
-            counts.iter().map(|&k| WeightedBin { mean: k as f64 / hits, second_moment: k as f64 / hits }).collect();
-        let test = chi_square(&observed, &vec![1.0 / BINS as f64; BINS], next.len() as u64, 5.0);
-        assert!(test.p_value > level, "{label}: next-height distribution rejected\n{}", test.worst_cells(BINS));
+        let observed: Vec<WeightedBin> = counts
+            .iter()
+            .map(|&k| WeightedBin {
+                mean: k as f64 / hits,
+                second_moment: k as f64 / hits,
+            })
+            .collect();
+        let test = chi_square(
+            &observed,
+            &vec![1.0 / BINS as f64; BINS],
+            next.len() as u64,
+            5.0,
+        );
+        assert!(
+            test.p_value > level,
+            "{label}: next-height distribution rejected\n{}",
+            test.worst_cells(BINS)
+        );
     }
 }
 
 #[test]
 fn escape_probability_and_next_height_follow_the_smith_height_process() {
-    let level = sidak(0.01, 4 * 2 * CHECKS.len());
+    let level = sidak(0.01, 2 * 2 * CHECKS.len());
     let r = Roughness { x: 0.6, y: 0.3 };
-    run(&Ggx(r), UniformHeight, cdf_uniform, 1 << 40, level);
-    run(&Ggx(r), GaussianHeight, cdf_gaussian, 2 << 40, level);
-    run(&Beckmann(r), UniformHeight, cdf_uniform, 3 << 40, level);
-    run(&Beckmann(r), GaussianHeight, cdf_gaussian, 4 << 40, level);
+    run(&Ggx(r), 1 << 40, level);
+    run(&Beckmann(r), 3 << 40, level);
 }
 
 #[test]
@@ -134,15 +165,17 @@ fn limits_of_the_free_flight() {
     // Hammon's symmetric Lambda gives a vertical downward ray rate 0 (§2.7): infinite depth.
     assert_eq!(Smith::Symmetric.rate(&ndf, -DVec3::Z), 0.0);
     assert_eq!(fly(0.4, false, 0.0, 1.0), Flight::Hit(f64::INFINITY));
-    // Heights at the boundary: the top is depth 0, the bottom infinite depth, both ways round.
-    for h in [UniformHeight.top(), GaussianHeight.top()] {
-        assert!(h == 1.0 || h == f64::INFINITY);
+    // The same point seen from the other side (§4.3): -ln(1 - e^{-tau}), accurate at both ends
+    // (closed forms: tau -> 0 gives -ln tau; large tau gives e^{-tau}), and an involution.
+    assert!((other_side_depth(1.0) - -(1.0 - (-1.0f64).exp()).ln()).abs() < 1e-15);
+    assert!((other_side_depth(1e-300) - 300.0 * std::f64::consts::LN_10).abs() < 1e-12);
+    assert!((other_side_depth(700.0) / (-700.0f64).exp() - 1.0).abs() < 1e-15);
+    assert_eq!(other_side_depth(0.0), f64::INFINITY);
+    assert_eq!(other_side_depth(f64::INFINITY), 0.0);
+    for tau in [1e-9, 0.1, 0.69, 0.7, 3.0, 30.0] {
+        assert!(
+            (other_side_depth(other_side_depth(tau)) / tau - 1.0).abs() < 1e-9,
+            "tau {tau}"
+        );
     }
-    assert_eq!(UniformHeight.depth(1.0), 0.0);
-    assert_eq!(UniformHeight.depth(-1.0), f64::INFINITY);
-    assert_eq!(GaussianHeight.depth(f64::INFINITY), 0.0);
-    assert_eq!(GaussianHeight.depth(f64::NEG_INFINITY), f64::INFINITY);
-    assert_eq!(UniformHeight.height(0.0), 1.0);
-    assert_eq!(GaussianHeight.height(0.0), f64::INFINITY);
-    assert_eq!(GaussianHeight.height(f64::INFINITY), f64::NEG_INFINITY);
 }

@@ -7,7 +7,7 @@
 //!   and exact full-sphere visible-normal sampling;
 //! * [`smith`]: which `Lambda` drives the height process (true full-sphere Smith or Hammon's
 //!   symmetric variant);
-//! * [`height`]: the height distribution and the free-flight law in optical depth;
+//! * [`height`]: the height process as free flights in optical depth;
 //! * [`normals`]: how the facet hit by a ray is drawn (visible normals or Hammon's rejection);
 //! * [`fresnel`]: Fresnel reflectances;
 //! * [`facet`]: the micro-BSDF of a single facet (conductor, dielectric, Lambertian, Hammon);

@@ -137,7 +137,11 @@ impl Ndf for Ggx {
 
     fn std_slope_cdf(r: f64) -> f64 {
         let r2 = r * r;
-        if r2.is_infinite() { 1.0 } else { r2 / (1.0 + r2) }
+        if r2.is_infinite() {
+            1.0
+        } else {
+            r2 / (1.0 + r2)
+        }
     }
 }
 
@@ -184,9 +188,17 @@ impl Ndf for Beckmann {
             return f64::NAN;
         }
         if w.z == 0.0 {
-            return if w.z.is_sign_positive() { f64::INFINITY } else { f64::NEG_INFINITY };
+            return if w.z.is_sign_positive() {
+                f64::INFINITY
+            } else {
+                f64::NEG_INFINITY
+            };
         }
-        if a > 0.0 { beckmann_lambda_above(a) } else { -1.0 - beckmann_lambda_above(-a) }
+        if a > 0.0 {
+            beckmann_lambda_above(a)
+        } else {
+            -1.0 - beckmann_lambda_above(-a)
+        }
     }
 
     /// `A = (1 + Lambda(w)) w_z` above the horizon and `Lambda(-w) |w_z|` below (§1.5, §10).
@@ -209,7 +221,11 @@ impl Ndf for Beckmann {
         let sin_theta = ws.x.hypot(ws.y);
         let (x, cos_phi, sin_phi) = if sin_theta > 0.0 {
             let mu = ws.z / sin_theta;
-            (visible_slope_beckmann(mu, rng), ws.x / sin_theta, ws.y / sin_theta)
+            (
+                visible_slope_beckmann(mu, rng),
+                ws.x / sin_theta,
+                ws.y / sin_theta,
+            )
         } else if ws.z > 0.0 {
             (erf_inv(2.0 * open01(rng) - 1.0), 1.0, 0.0)
         } else {
@@ -268,7 +284,11 @@ fn visible_slope_beckmann<R: Rng + ?Sized>(mu: f64, rng: &mut R) -> f64 {
         }
         let slope = (mu - x) * (-x * x).exp();
         let newton = x - f / slope;
-        let next = if newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+        let next = if newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
         if (next - x).abs() <= 1e-15 * (1.0 + x.abs()) || hi - lo <= 1e-15 * (1.0 + x.abs()) {
             return next;
         }

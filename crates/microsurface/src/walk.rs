@@ -3,24 +3,25 @@
 //! A photon enters from the light's side at the top of the height support (optical depth 0)
 //! and alternates free flights in optical depth (§2.4) with facet interactions (§4.2–§4.5)
 //! until it escapes. A ray inside a dielectric is walked in the flipped frame (§4.3): its
-//! direction and height are negated, which turns it into an outside problem.
+//! direction is negated and its depth is measured from below, which turns it into an outside
+//! problem; a refraction converts the depth to the other side.
 
 use glam::DVec3;
 use rand::Rng;
 
 use crate::facet::{Branch, Facet, Interaction, Side};
-use crate::height::{Flight, HeightDistribution, fly};
+use crate::height::{Flight, fly, other_side_depth};
 use crate::ndf::Ndf;
 use crate::normals::Normals;
 use crate::random::{exp1, open01};
 use crate::smith::Smith;
 
-/// A microsurface: an NDF, a height distribution, the Smith variant driving the free flights
-/// and the law of the hit normals. Facet materials plug in independently.
+/// A microsurface: an NDF, the Smith variant driving the free flights and the law of the hit
+/// normals. Facet materials plug in independently. (The height distribution does not appear:
+/// the walk runs in optical depth, on which no height law has any effect, §2.1.)
 #[derive(Clone, Copy, Debug)]
-pub struct Microsurface<N, H> {
+pub struct Microsurface<N> {
     pub ndf: N,
-    pub heights: H,
     pub smith: Smith,
     pub normals: Normals,
 }
@@ -61,10 +62,11 @@ pub trait Observer<const C: usize> {
     fn lose(&mut self, loss: Loss, weight: &[f64; C]);
 }
 
-/// A ray of the walk: height, travel direction, side, weight and number of interactions so far.
+/// A ray of the walk: optical depth on its own side, travel direction, side, weight and
+/// number of interactions so far.
 #[derive(Clone, Copy, Debug)]
 pub struct Ray<const C: usize> {
-    h: f64,
+    tau: f64,
     d: DVec3,
     side: Side,
     beta: [f64; C],
@@ -79,7 +81,7 @@ fn weight_is_valid<const C: usize>(w: &[f64; C]) -> bool {
     w.iter().all(|x| x.is_finite() && *x >= 0.0)
 }
 
-impl<N: Ndf, H: HeightDistribution> Microsurface<N, H> {
+impl<N: Ndf> Microsurface<N> {
     /// Walks one photon arriving from `wi` (pointing towards the light; `wi_z > 0` from
     /// outside, `wi_z < 0` from inside a dielectric) with unit weight in every channel, and
     /// reports every escape and loss to `observer`. `stack` is scratch space for split branches.
@@ -96,14 +98,19 @@ impl<N: Ndf, H: HeightDistribution> Microsurface<N, H> {
         R: Rng + ?Sized,
         O: Observer<C>,
     {
-        let side = if wi.z >= 0.0 { Side::Outside } else { Side::Inside };
-        let top = self.heights.top();
-        let h = match side {
-            Side::Outside => top,
-            Side::Inside => -top,
+        let side = if wi.z >= 0.0 {
+            Side::Outside
+        } else {
+            Side::Inside
         };
         stack.clear();
-        stack.push(Ray { h, d: -wi, side, beta: [1.0; C], order: 0 });
+        stack.push(Ray {
+            tau: 0.0,
+            d: -wi,
+            side,
+            beta: [1.0; C],
+            order: 0,
+        });
         while let Some(ray) = stack.pop() {
             self.follow(facet, policy, ray, rng, stack, observer);
         }
@@ -124,28 +131,22 @@ impl<N: Ndf, H: HeightDistribution> Microsurface<N, H> {
         O: Observer<C>,
     {
         loop {
-            // The flipped frame (§4.3): on the inside, negate height and direction.
-            let (h, d) = match ray.side {
-                Side::Outside => (ray.h, ray.d),
-                Side::Inside => (-ray.h, -ray.d),
+            // The flipped frame (§4.3): on the inside, negate the direction.
+            let d = match ray.side {
+                Side::Outside => ray.d,
+                Side::Inside => -ray.d,
             };
-            let tau = self.heights.depth(h);
-            if tau.is_nan() {
-                return observer.lose(Loss::Invalid, &ray.beta);
-            }
-            if tau.is_infinite() {
-                return observer.lose(Loss::Trapped, &ray.beta);
-            }
             let rate = self.smith.rate(&self.ndf, d);
-            let tau = match fly(tau, d.z > 0.0, rate, exp1(rng)) {
+            ray.tau = match fly(ray.tau, d.z > 0.0, rate, exp1(rng)) {
                 Flight::Escape => return observer.escape(ray.order, ray.side, ray.d, &ray.beta),
                 Flight::Hit(tau) => tau,
             };
-            let h = self.heights.height(tau);
-            ray.h = match ray.side {
-                Side::Outside => h,
-                Side::Inside => -h,
-            };
+            if ray.tau.is_nan() {
+                return observer.lose(Loss::Invalid, &ray.beta);
+            }
+            if ray.tau.is_infinite() {
+                return observer.lose(Loss::Trapped, &ray.beta);
+            }
             ray.order += 1;
             if ray.order >= RUNAWAY_ORDER {
                 return observer.lose(Loss::Runaway, &ray.beta);
@@ -191,8 +192,17 @@ impl<N: Ndf, H: HeightDistribution> Microsurface<N, H> {
 /// The ray that follows `branch`.
 fn continue_with<const C: usize>(ray: &Ray<C>, branch: &Branch<C>) -> Ray<C> {
     Ray {
+        tau: if branch.crosses {
+            other_side_depth(ray.tau)
+        } else {
+            ray.tau
+        },
         d: branch.dir,
-        side: if branch.crosses { ray.side.other() } else { ray.side },
+        side: if branch.crosses {
+            ray.side.other()
+        } else {
+            ray.side
+        },
         beta: std::array::from_fn(|i| ray.beta[i] * branch.weight[i]),
         ..*ray
     }
@@ -201,7 +211,12 @@ fn continue_with<const C: usize>(ray: &Ray<C>, branch: &Branch<C>) -> Ray<C> {
 /// Chooses one of two exclusive branches with probability proportional to the weight each
 /// would carry (summed over channels), and divides its factor by that probability so the
 /// choice is unbiased (§4.6). `None` if neither branch carries weight.
-fn choose<const C: usize>(beta: &[f64; C], a: Branch<C>, b: Branch<C>, u: f64) -> Option<Branch<C>> {
+fn choose<const C: usize>(
+    beta: &[f64; C],
+    a: Branch<C>,
+    b: Branch<C>,
+    u: f64,
+) -> Option<Branch<C>> {
     let carried = |br: &Branch<C>| beta.iter().zip(&br.weight).map(|(x, w)| x * w).sum::<f64>();
     let (wa, wb) = (carried(&a), carried(&b));
     let total = wa + wb;
