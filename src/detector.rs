@@ -75,17 +75,21 @@ impl<const C: usize> Tally<C> {
     /// Adds one photon's total contribution.
     #[inline]
     pub fn add(&mut self, w: &[f64; C]) {
-        for c in 0..C {
-            self.sum[c].add(w[c]);
-            self.sum_sq[c].add(w[c] * w[c]);
+        for ((sum, sum_sq), &x) in self.sum.iter_mut().zip(&mut self.sum_sq).zip(w) {
+            sum.add(x);
+            sum_sq.add(x * x);
         }
         self.count += 1;
     }
 
     fn merge(&mut self, other: &Self) {
-        for c in 0..C {
-            self.sum[c].merge(other.sum[c]);
-            self.sum_sq[c].merge(other.sum_sq[c]);
+        for (a, b) in self
+            .sum
+            .iter_mut()
+            .zip(&other.sum)
+            .chain(self.sum_sq.iter_mut().zip(&other.sum_sq))
+        {
+            a.merge(*b);
         }
         self.count += other.count;
     }
@@ -214,6 +218,14 @@ pub struct Detector<const C: usize> {
     any_loss: bool,
 }
 
+/// `acc += w`, channel by channel.
+#[inline]
+fn accumulate<const C: usize>(acc: &mut [f64; C], w: &[f64; C]) {
+    for (a, x) in acc.iter_mut().zip(w) {
+        *a += x;
+    }
+}
+
 fn loss_index(loss: Loss) -> usize {
     match loss {
         Loss::Trapped => 0,
@@ -272,16 +284,12 @@ impl<const C: usize> Detector<C> {
         self.photons += 1;
         let mut total = [0.0; C];
         for d in &self.pending {
-            for c in 0..C {
-                total[c] += d.weight[c];
-            }
+            accumulate(&mut total, &d.weight);
         }
         if self.any_loss {
             for (tally, w) in self.lost.iter_mut().zip(&self.pending_loss) {
                 tally.add(w);
-                for c in 0..C {
-                    total[c] += w[c];
-                }
+                accumulate(&mut total, w);
             }
             self.pending_loss = [[0.0; C]; 3];
             self.any_loss = false;
@@ -320,10 +328,8 @@ impl<const C: usize> Detector<C> {
         let mut bin_sum = [0.0; C];
         let mut hemi_sum = [0.0; C];
         for (n, &(slot, hemi, i, w)) in keyed.iter().enumerate() {
-            for c in 0..C {
-                bin_sum[c] += w[c];
-                hemi_sum[c] += w[c];
-            }
+            accumulate(&mut bin_sum, &w);
+            accumulate(&mut hemi_sum, &w);
             let next = keyed.get(n + 1);
             if next.is_none_or(|&(s, h, j, _)| (s, h, j) != (slot, hemi, i)) {
                 self.orders[slot].bins[i].add(&bin_sum);
@@ -370,10 +376,7 @@ impl<const C: usize> Observer<C> for Detector<C> {
     }
 
     fn lose(&mut self, loss: Loss, weight: &[f64; C]) {
-        let slot = &mut self.pending_loss[loss_index(loss)];
-        for c in 0..C {
-            slot[c] += weight[c];
-        }
+        accumulate(&mut self.pending_loss[loss_index(loss)], weight);
         self.any_loss = true;
     }
 }

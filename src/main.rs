@@ -1,10 +1,12 @@
 //! The `smithwalk` command line.
 
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
+use smithwalk::Simulation;
 use smithwalk::config::Config;
 use smithwalk::output::{EnergyBalance, prepare_dir};
 
@@ -67,43 +69,57 @@ fn run(
     prepare_dir(&out)?;
     let sim = smithwalk::simulate(&config, threads, true)?;
     let written = smithwalk::write_outputs(&sim, &config, &out)?;
+    if let Err(e) = print_summary(&sim, &config, &written) {
+        // A closed pipe (`| head`) is not an error of the run: the outputs are written.
+        if e.kind() != std::io::ErrorKind::BrokenPipe {
+            return Err(e.into());
+        }
+    }
+    Ok(())
+}
+
+/// The end summary: throughput and each case's energy balance (channel 0 for RGB runs).
+fn print_summary(sim: &Simulation, config: &Config, written: &[PathBuf]) -> std::io::Result<()> {
+    let mut out = std::io::stdout().lock();
     let total = config.paths * sim.cases.len() as u64;
-    println!(
-        "{} cases x {} paths in {:.2} s on {} threads: {:.3e} paths/s ({:.3e} per thread)",
+    let rate = total as f64 / sim.wall_seconds;
+    writeln!(
+        out,
+        "{} cases x {} paths in {:.2} s on {} threads: {rate:.3e} paths/s ({:.3e} per thread)",
         sim.cases.len(),
         config.paths,
         sim.wall_seconds,
         sim.threads,
-        total as f64 / sim.wall_seconds,
-        total as f64 / sim.wall_seconds / sim.threads as f64
-    );
-    println!(
-        "{:>5}  {:<44} {:>9} {:>9} {:>9} {:>9} {:>6}",
+        rate / sim.threads as f64
+    )?;
+    writeln!(
+        out,
+        "{:>5}  {:<48} {:>9} {:>9} {:>9} {:>9} {:>6}",
         "case", "surface / material / incidence", "R", "T", "absorbed", "lost", "orders"
-    );
+    )?;
     for (case, result) in sim.cases.iter().zip(&sim.results) {
         let e = EnergyBalance::from_result(result);
         let label = format!(
-            "{:?} a=({},{}) {} th={}",
+            "{:?} a=({},{}) {} th={:.2}",
             case.ndf,
             case.alpha_x,
             case.alpha_y,
             case.material.label(),
             case.theta_i_deg
         );
-        println!(
-            "{:>5}  {:<44} {:>9.6} {:>9.6} {:>9.6} {:>9.2e} {:>6}",
+        writeln!(
+            out,
+            "{:>5}  {label:<48} {:>9.6} {:>9.6} {:>9.6} {:>9.2e} {:>6}",
             case.index,
-            label,
             e.reflected[0],
             e.transmitted[0],
             e.absorbed[0],
             e.lost(),
             e.highest_order
-        );
+        )?;
     }
     for path in written {
-        println!("wrote {}", path.display());
+        writeln!(out, "wrote {}", path.display())?;
     }
     Ok(())
 }

@@ -155,13 +155,13 @@ fn lobe_rows<const C: usize>(
                     let (phi_lo, phi_hi) = grid.phi_edges_deg(ip);
                     let tally =
                         &tallies.bins[hemisphere as usize * grid.bins() + ic * grid.phi_bins + ip];
-                    for c in 0..C {
+                    for (c, channel) in CHANNEL_NAMES.iter().enumerate().take(C) {
                         let (energy, se) = tally.mean_and_stderr(n, c);
                         let mut row = fields.clone();
                         row.push(slot.to_string());
                         row.push(format!("{hemisphere:?}"));
                         if C > 1 {
-                            row.push(CHANNEL_NAMES[c].to_string());
+                            row.push(channel.to_string());
                         }
                         row.extend(
                             [cos_lo, cos_hi, phi_lo, phi_hi, energy, se].map(|v| v.to_string()),

@@ -70,8 +70,8 @@ pub fn chunk_rng(seed: u64, case: usize, chunk: u64) -> Pcg64Mcg {
 /// The result of one case: its detector, in one or three channels.
 #[derive(Clone, Debug)]
 pub enum CaseResult {
-    Mono(Detector<1>),
-    Rgb(Detector<3>),
+    Mono(Box<Detector<1>>),
+    Rgb(Box<Detector<3>>),
 }
 
 /// Simulates one case over `threads` worker threads of `pool`.
@@ -83,9 +83,9 @@ pub fn simulate_case(
     progress: &ProgressBar,
 ) -> CaseResult {
     if rgb {
-        CaseResult::Rgb(with_ndf::<3>(case, settings, pool, progress))
+        CaseResult::Rgb(Box::new(with_ndf::<3>(case, settings, pool, progress)))
     } else {
-        CaseResult::Mono(with_ndf::<1>(case, settings, pool, progress))
+        CaseResult::Mono(Box::new(with_ndf::<1>(case, settings, pool, progress)))
     }
 }
 

@@ -116,7 +116,7 @@ fn run<N: Ndf>(ndf: &N, seed: u128, level: f64) {
         let edges: Vec<f64> = (0..=BINS)
             .map(|k| quantile(k as f64 / BINS as f64))
             .collect();
-        let mut counts = vec![0u64; BINS];
+        let mut counts = [0u64; BINS];
         for x in &next {
             let k = edges.partition_point(|e| e <= x).clamp(1, BINS) - 1;
             counts[k] += 1;
@@ -131,7 +131,7 @@ fn run<N: Ndf>(ndf: &N, seed: u128, level: f64) {
             .collect();
         let test = chi_square(
             &observed,
-            &vec![1.0 / BINS as f64; BINS],
+            &[1.0 / BINS as f64; BINS],
             next.len() as u64,
             5.0,
         );

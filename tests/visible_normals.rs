@@ -106,7 +106,10 @@ fn sampled<N: Ndf>(ndf: &N, normals: Normals, w: DVec3, seed: u64) -> Vec<Weight
 const DIRECTIONS: [(f64, f64); 4] = [(30.0, 40.0), (100.0, 200.0), (135.0, 10.0), (160.0, 290.0)];
 const ROUGHNESSES: [(f64, f64); 3] = [(0.5, 0.5), (0.5, 0.2), (1.5, 0.8)];
 
-fn all_cases() -> Vec<(&'static str, (f64, f64), (f64, f64))> {
+/// (NDF, (alpha_x, alpha_y), (theta_deg, phi_deg)).
+type NormalCase = (&'static str, (f64, f64), (f64, f64));
+
+fn all_cases() -> Vec<NormalCase> {
     let mut v = Vec::new();
     for ndf in ["ggx", "beckmann"] {
         for r in ROUGHNESSES {
