@@ -4,9 +4,7 @@ use glam::DVec3;
 use itertools::iproduct;
 use serde::Serialize;
 
-use crate::config::{
-    Config, HeightKind, IncidentSide, MaterialConfig, NdfKind, NormalsKind, SmithKind,
-};
+use crate::config::{Config, HeightKind, IncidentSide, MaterialConfig, NdfKind, NormalsKind, SmithKind};
 
 /// One measurement: a surface, a facet material and an incident direction.
 #[derive(Clone, Debug, Serialize, PartialEq)]
@@ -55,26 +53,9 @@ pub fn expand(config: &Config) -> Vec<Case> {
     );
     product
         .enumerate()
-        .map(
-            |(
-                index,
-                (ndf, alpha, height, smith, normals, material, side, theta_i_deg, phi_i_deg),
-            )| {
-                let (alpha_x, alpha_y) = alpha.xy();
-                Case {
-                    index,
-                    ndf,
-                    alpha_x,
-                    alpha_y,
-                    height,
-                    smith,
-                    normals,
-                    material,
-                    theta_i_deg,
-                    phi_i_deg,
-                    side,
-                }
-            },
-        )
+        .map(|(index, (ndf, alpha, height, smith, normals, material, side, theta_i_deg, phi_i_deg))| {
+            let (alpha_x, alpha_y) = alpha.xy();
+            Case { index, ndf, alpha_x, alpha_y, height, smith, normals, material, theta_i_deg, phi_i_deg, side }
+        })
         .collect()
 }

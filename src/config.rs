@@ -179,18 +179,9 @@ impl MaterialConfig {
             | MaterialConfig::Dielectric { name: Some(n), .. }
             | MaterialConfig::Diffuse { name: Some(n), .. }
             | MaterialConfig::Hammon { name: Some(n), .. } => n.clone(),
-            MaterialConfig::Conductor {
-                fresnel,
-                f0,
-                eta,
-                k,
-                ..
-            } => match fresnel {
+            MaterialConfig::Conductor { fresnel, f0, eta, k, .. } => match fresnel {
                 FresnelKind::None => "conductor F=1".into(),
-                FresnelKind::Schlick => format!(
-                    "conductor schlick f0={}",
-                    f0.unwrap_or(Channels::Mono(f64::NAN))
-                ),
+                FresnelKind::Schlick => format!("conductor schlick f0={}", f0.unwrap_or(Channels::Mono(f64::NAN))),
                 FresnelKind::Exact => format!(
                     "conductor eta={} k={}",
                     eta.unwrap_or(Channels::Mono(f64::NAN)),
@@ -219,9 +210,7 @@ impl MaterialConfig {
 
     fn channel_params(&self) -> Vec<Channels> {
         match self {
-            MaterialConfig::Conductor { f0, eta, k, .. } => {
-                [f0, eta, k].into_iter().flatten().copied().collect()
-            }
+            MaterialConfig::Conductor { f0, eta, k, .. } => [f0, eta, k].into_iter().flatten().copied().collect(),
             MaterialConfig::Dielectric { .. } => vec![],
             MaterialConfig::Diffuse { albedo, .. } => vec![*albedo],
             MaterialConfig::Hammon { f0, albedo, .. } => vec![*f0, *albedo],
@@ -312,11 +301,7 @@ fn default_phi_bins() -> usize {
 
 impl Default for DetectorConfig {
     fn default() -> Self {
-        Self {
-            cos_theta_bins: default_cos_bins(),
-            phi_bins: default_phi_bins(),
-            max_order: None,
-        }
+        Self { cos_theta_bins: default_cos_bins(), phi_bins: default_phi_bins(), max_order: None }
     }
 }
 
@@ -338,10 +323,7 @@ fn default_threshold() -> f64 {
 
 impl Default for EnergyConfig {
     fn default() -> Self {
-        Self {
-            split: default_split(),
-            threshold: default_threshold(),
-        }
+        Self { split: default_split(), threshold: default_threshold() }
     }
 }
 
@@ -370,44 +352,24 @@ fn default_seed() -> u64 {
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     #[error("cannot read config {path}: {source}")]
-    Read {
-        path: String,
-        source: std::io::Error,
-    },
+    Read { path: String, source: std::io::Error },
     #[error("config {path} is not valid: {message}")]
     Parse { path: String, message: String },
     #[error("`{field}` = {value} is not allowed: {allowed}")]
-    Invalid {
-        field: String,
-        value: String,
-        allowed: String,
-    },
+    Invalid { field: String, value: String, allowed: String },
 }
 
-fn invalid(
-    field: impl Into<String>,
-    value: impl fmt::Display,
-    allowed: impl Into<String>,
-) -> ConfigError {
-    ConfigError::Invalid {
-        field: field.into(),
-        value: value.to_string(),
-        allowed: allowed.into(),
-    }
+fn invalid(field: impl Into<String>, value: impl fmt::Display, allowed: impl Into<String>) -> ConfigError {
+    ConfigError::Invalid { field: field.into(), value: value.to_string(), allowed: allowed.into() }
 }
 
 impl Config {
     /// Reads, parses and validates a TOML configuration file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| ConfigError::Read { path: path.display().to_string(), source })?;
         let config = Self::parse(&text).map_err(|e| match e {
-            ConfigError::Parse { message, .. } => ConfigError::Parse {
-                path: path.display().to_string(),
-                message,
-            },
+            ConfigError::Parse { message, .. } => ConfigError::Parse { path: path.display().to_string(), message },
             other => other,
         })?;
         Ok(config)
@@ -415,10 +377,8 @@ impl Config {
 
     /// Parses and validates TOML text.
     pub fn parse(text: &str) -> Result<Self, ConfigError> {
-        let config: Config = toml::from_str(text).map_err(|e| ConfigError::Parse {
-            path: "<text>".into(),
-            message: e.to_string(),
-        })?;
+        let config: Config =
+            toml::from_str(text).map_err(|e| ConfigError::Parse { path: "<text>".into(), message: e.to_string() })?;
         config.validate()?;
         Ok(config)
     }
@@ -426,11 +386,7 @@ impl Config {
     /// Checks every field against what the simulator supports.
     pub fn validate(&self) -> Result<(), ConfigError> {
         if self.paths < 2 {
-            return Err(invalid(
-                "paths",
-                self.paths,
-                "at least 2 photons per case (standard errors need two)",
-            ));
+            return Err(invalid("paths", self.paths, "at least 2 photons per case (standard errors need two)"));
         }
         let s = &self.surface;
         non_empty("surface.ndf", &s.ndf)?;
@@ -442,11 +398,7 @@ impl Config {
             let (x, y) = a.xy();
             for v in [x, y] {
                 if !(v.is_finite() && v > 0.0) {
-                    return Err(invalid(
-                        "surface.alpha",
-                        v,
-                        "a finite roughness > 0 (tested from 1e-3 to 3)",
-                    ));
+                    return Err(invalid("surface.alpha", v, "a finite roughness > 0 (tested from 1e-3 to 3)"));
                 }
             }
         }
@@ -467,17 +419,9 @@ impl Config {
         }
         let (field, values, limit) = match (&i.theta_deg, &i.theta_rad) {
             (Some(d), _) => ("incident.theta_deg", d.values(), 90.0),
-            (None, Some(r)) => (
-                "incident.theta_rad",
-                r.values(),
-                std::f64::consts::FRAC_PI_2,
-            ),
+            (None, Some(r)) => ("incident.theta_rad", r.values(), std::f64::consts::FRAC_PI_2),
             (None, None) => {
-                return Err(invalid(
-                    "incident.theta_deg",
-                    "missing",
-                    "a polar angle or a list of them",
-                ));
+                return Err(invalid("incident.theta_deg", "missing", "a polar angle or a list of them"));
             }
         };
         if values.is_empty() {
@@ -491,11 +435,7 @@ impl Config {
         non_empty("incident.phi_deg", &i.phi_deg)?;
         for p in i.phi_deg.values() {
             if !p.is_finite() {
-                return Err(invalid(
-                    "incident.phi_deg",
-                    p,
-                    "a finite azimuth in degrees",
-                ));
+                return Err(invalid("incident.phi_deg", p, "a finite azimuth in degrees"));
             }
         }
         non_empty("incident.side", &i.side)?;
@@ -504,39 +444,22 @@ impl Config {
                 return Err(invalid(
                     "incident.side",
                     "\"inside\"",
-                    format!(
-                        "light from inside needs dielectric materials only, but a material is {}",
-                        m.kind()
-                    ),
+                    format!("light from inside needs dielectric materials only, but a material is {}", m.kind()),
                 ));
             }
         }
         let d = &self.detector;
         if d.cos_theta_bins == 0 || d.cos_theta_bins > 4096 {
-            return Err(invalid(
-                "detector.cos_theta_bins",
-                d.cos_theta_bins,
-                "an integer from 1 to 4096",
-            ));
+            return Err(invalid("detector.cos_theta_bins", d.cos_theta_bins, "an integer from 1 to 4096"));
         }
         if d.phi_bins == 0 || d.phi_bins > 4096 {
-            return Err(invalid(
-                "detector.phi_bins",
-                d.phi_bins,
-                "an integer from 1 to 4096",
-            ));
+            return Err(invalid("detector.phi_bins", d.phi_bins, "an integer from 1 to 4096"));
         }
         if d.max_order == Some(0) {
-            return Err(invalid(
-                "detector.max_order",
-                0,
-                "an order >= 1, or leave it out to keep every order",
-            ));
+            return Err(invalid("detector.max_order", 0, "an order >= 1, or leave it out to keep every order"));
         }
         let e = &self.energy;
-        if !(e.threshold.is_finite() && (0.0..=1.0).contains(&e.threshold))
-            || (e.split && e.threshold == 0.0)
-        {
+        if !(e.threshold.is_finite() && (0.0..=1.0).contains(&e.threshold)) || (e.split && e.threshold == 0.0) {
             return Err(invalid(
                 "energy.threshold",
                 e.threshold,
@@ -554,21 +477,12 @@ impl Config {
 
 fn non_empty<T: Clone>(field: &str, v: &OneOrMany<T>) -> Result<(), ConfigError> {
     if v.values().is_empty() {
-        return Err(invalid(
-            field,
-            "[]",
-            "at least one value (an empty list expands to no cases)",
-        ));
+        return Err(invalid(field, "[]", "at least one value (an empty list expands to no cases)"));
     }
     Ok(())
 }
 
-fn check_channels(
-    field: String,
-    c: Channels,
-    ok: impl Fn(f64) -> bool,
-    allowed: &str,
-) -> Result<(), ConfigError> {
+fn check_channels(field: String, c: Channels, ok: impl Fn(f64) -> bool, allowed: &str) -> Result<(), ConfigError> {
     for v in c.values() {
         if !(v.is_finite() && ok(v)) {
             return Err(invalid(field, c, allowed.to_string()));
@@ -580,22 +494,13 @@ fn check_channels(
 fn validate_material(field: &str, m: &MaterialConfig) -> Result<(), ConfigError> {
     let unit = |v: f64| (0.0..=1.0).contains(&v);
     match m {
-        MaterialConfig::Conductor {
-            fresnel,
-            f0,
-            eta,
-            k,
-            ..
-        } => {
+        MaterialConfig::Conductor { fresnel, f0, eta, k, .. } => {
             let needs = |name: &str, p: &Option<Channels>, present: bool| {
                 if p.is_some() != present {
                     let allowed = if present {
                         format!("fresnel = \"{}\" needs `{name}`", fresnel_name(*fresnel))
                     } else {
-                        format!(
-                            "`{name}` is not used with fresnel = \"{}\"",
-                            fresnel_name(*fresnel)
-                        )
+                        format!("`{name}` is not used with fresnel = \"{}\"", fresnel_name(*fresnel))
                     };
                     let value = p.map_or("missing".to_string(), |c| c.to_string());
                     return Err(invalid(format!("{field}.{name}"), value, allowed));
@@ -609,20 +514,10 @@ fn validate_material(field: &str, m: &MaterialConfig) -> Result<(), ConfigError>
                 check_channels(format!("{field}.f0"), *f0, unit, "reflectances in [0, 1]")?;
             }
             if let Some(eta) = eta {
-                check_channels(
-                    format!("{field}.eta"),
-                    *eta,
-                    |v| v > 0.0,
-                    "real parts of the index > 0",
-                )?;
+                check_channels(format!("{field}.eta"), *eta, |v| v > 0.0, "real parts of the index > 0")?;
             }
             if let Some(k) = k {
-                check_channels(
-                    format!("{field}.k"),
-                    *k,
-                    |v| v >= 0.0,
-                    "extinction coefficients >= 0",
-                )?;
+                check_channels(format!("{field}.k"), *k, |v| v >= 0.0, "extinction coefficients >= 0")?;
             }
         }
         MaterialConfig::Dielectric { eta, .. } => {
@@ -635,21 +530,11 @@ fn validate_material(field: &str, m: &MaterialConfig) -> Result<(), ConfigError>
             }
         }
         MaterialConfig::Diffuse { albedo, .. } => {
-            check_channels(
-                format!("{field}.albedo"),
-                *albedo,
-                unit,
-                "albedos in [0, 1]",
-            )?;
+            check_channels(format!("{field}.albedo"), *albedo, unit, "albedos in [0, 1]")?;
         }
         MaterialConfig::Hammon { f0, albedo, .. } => {
             check_channels(format!("{field}.f0"), *f0, unit, "reflectances in [0, 1]")?;
-            check_channels(
-                format!("{field}.albedo"),
-                *albedo,
-                unit,
-                "albedos in [0, 1]",
-            )?;
+            check_channels(format!("{field}.albedo"), *albedo, unit, "albedos in [0, 1]")?;
         }
     }
     Ok(())

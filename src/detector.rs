@@ -63,11 +63,7 @@ pub struct Tally<const C: usize> {
 
 impl<const C: usize> Default for Tally<C> {
     fn default() -> Self {
-        Self {
-            sum: [Fixed::default(); C],
-            sum_sq: [Fixed::default(); C],
-            count: 0,
-        }
+        Self { sum: [Fixed::default(); C], sum_sq: [Fixed::default(); C], count: 0 }
     }
 }
 
@@ -83,12 +79,7 @@ impl<const C: usize> Tally<C> {
     }
 
     fn merge(&mut self, other: &Self) {
-        for (a, b) in self
-            .sum
-            .iter_mut()
-            .zip(&other.sum)
-            .chain(self.sum_sq.iter_mut().zip(&other.sum_sq))
-        {
+        for (a, b) in self.sum.iter_mut().zip(&other.sum).chain(self.sum_sq.iter_mut().zip(&other.sum_sq)) {
             a.merge(*b);
         }
         self.count += other.count;
@@ -128,17 +119,13 @@ impl Grid {
         if phi < 0.0 {
             phi += std::f64::consts::TAU;
         }
-        let ip = ((phi * (self.phi_bins as f64 / std::f64::consts::TAU)) as usize)
-            .min(self.phi_bins - 1);
+        let ip = ((phi * (self.phi_bins as f64 / std::f64::consts::TAU)) as usize).min(self.phi_bins - 1);
         ic * self.phi_bins + ip
     }
 
     /// `[|cos| lo, |cos| hi]` of a cos index.
     pub fn cos_edges(&self, ic: usize) -> (f64, f64) {
-        (
-            ic as f64 / self.cos_bins as f64,
-            (ic + 1) as f64 / self.cos_bins as f64,
-        )
+        (ic as f64 / self.cos_bins as f64, (ic + 1) as f64 / self.cos_bins as f64)
     }
 
     /// `[phi lo, phi hi]` in degrees of a phi index.
@@ -174,10 +161,7 @@ pub struct OrderTallies<const C: usize> {
 
 impl<const C: usize> OrderTallies<C> {
     fn new(grid: &Grid) -> Self {
-        Self {
-            bins: vec![Tally::default(); 2 * grid.bins()],
-            albedo: [Tally::default(); 2],
-        }
+        Self { bins: vec![Tally::default(); 2 * grid.bins()], albedo: [Tally::default(); 2] }
     }
 
     fn merge(&mut self, other: &Self) {
@@ -238,19 +222,11 @@ impl<const C: usize> Detector<C> {
     /// A detector for light arriving from `wi` (towards the light).
     pub fn new(grid: Grid, wi: DVec3, max_order: Option<u32>) -> Self {
         let horizontal = wi.x.hypot(wi.y);
-        let rotation = if horizontal > 0.0 {
-            (wi.x / horizontal, wi.y / horizontal)
-        } else {
-            (1.0, 0.0)
-        };
+        let rotation = if horizontal > 0.0 { (wi.x / horizontal, wi.y / horizontal) } else { (1.0, 0.0) };
         Self {
             grid,
             rotation,
-            incident_side: if wi.z >= 0.0 {
-                Side::Outside
-            } else {
-                Side::Inside
-            },
+            incident_side: if wi.z >= 0.0 { Side::Outside } else { Side::Inside },
             max_order,
             orders: vec![OrderTallies::new(&grid)],
             accounted: Tally::default(),
@@ -317,8 +293,7 @@ impl<const C: usize> Detector<C> {
     /// per (slot, hemisphere) before squaring, so variances stay per photon (§4.6).
     fn add_split_photon(&mut self) {
         let bins = self.grid.bins();
-        let mut keyed: Vec<(usize, usize, usize, [f64; C])> =
-            Vec::with_capacity(2 * self.pending.len());
+        let mut keyed: Vec<(usize, usize, usize, [f64; C])> = Vec::with_capacity(2 * self.pending.len());
         for d in &self.pending {
             let i = d.hemisphere as usize * bins + d.bin;
             keyed.push((0, d.hemisphere as usize, i, d.weight));
@@ -361,18 +336,9 @@ impl<const C: usize> Detector<C> {
 impl<const C: usize> Observer<C> for Detector<C> {
     #[inline]
     fn escape(&mut self, order: u32, side: Side, dir: DVec3, weight: &[f64; C]) {
-        let hemisphere = if side == self.incident_side {
-            Hemisphere::R
-        } else {
-            Hemisphere::T
-        };
+        let hemisphere = if side == self.incident_side { Hemisphere::R } else { Hemisphere::T };
         let bin = self.grid.bin(dir, self.rotation);
-        self.pending.push(Deposit {
-            slot: self.slot(order),
-            hemisphere,
-            bin,
-            weight: *weight,
-        });
+        self.pending.push(Deposit { slot: self.slot(order), hemisphere, bin, weight: *weight });
     }
 
     fn lose(&mut self, loss: Loss, weight: &[f64; C]) {

@@ -37,11 +37,7 @@ pub struct Simulation {
 }
 
 /// Simulates every case of `config` on `threads` threads (all cores if `None`).
-pub fn simulate(
-    config: &Config,
-    threads: Option<usize>,
-    show_progress: bool,
-) -> Result<Simulation> {
+pub fn simulate(config: &Config, threads: Option<usize>, show_progress: bool) -> Result<Simulation> {
     let cases = cases::expand(config);
     let settings = RunSettings::from_config(config);
     let rgb = config.is_rgb();
@@ -51,11 +47,7 @@ pub fn simulate(
     }
     let pool = builder.build().context("cannot start the worker threads")?;
     let total = settings.paths * cases.len() as u64;
-    let progress = if show_progress {
-        ProgressBar::new(total)
-    } else {
-        ProgressBar::hidden()
-    };
+    let progress = if show_progress { ProgressBar::new(total) } else { ProgressBar::hidden() };
     progress.set_style(
         ProgressStyle::with_template(
             "{elapsed_precise} [{bar:40}] {human_pos}/{human_len} paths ({per_sec}, eta {eta})",
@@ -64,10 +56,7 @@ pub fn simulate(
         .progress_chars("=> "),
     );
     let start = Instant::now();
-    let results = cases
-        .iter()
-        .map(|case| simulate_case(case, &settings, rgb, &pool, &progress))
-        .collect();
+    let results = cases.iter().map(|case| simulate_case(case, &settings, rgb, &pool, &progress)).collect();
     progress.finish_and_clear();
     Ok(Simulation {
         cases,

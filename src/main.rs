@@ -11,10 +11,7 @@ use smithwalk::config::Config;
 use smithwalk::output::{EnergyBalance, prepare_dir};
 
 #[derive(Parser)]
-#[command(
-    version,
-    about = "A virtual gonioreflectometer for the Smith microsurface"
-)]
+#[command(version, about = "A virtual gonioreflectometer for the Smith microsurface")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -60,11 +57,7 @@ fn run(
         anyhow::bail!("`--threads` = 0 is not allowed: at least 1 thread");
     }
     let out = out.unwrap_or_else(|| {
-        PathBuf::from("out").join(
-            config_path
-                .file_stem()
-                .map_or("run".into(), |s| s.to_string_lossy().into_owned()),
-        )
+        PathBuf::from("out").join(config_path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()))
     });
     prepare_dir(&out)?;
     let sim = smithwalk::simulate(&config, threads, true)?;
@@ -127,13 +120,7 @@ fn print_summary(sim: &Simulation, config: &Config, written: &[PathBuf]) -> std:
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run {
-            config,
-            paths,
-            seed,
-            threads,
-            out,
-        } => run(config, paths, seed, threads, out),
+        Command::Run { config, paths, seed, threads, out } => run(config, paths, seed, threads, out),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

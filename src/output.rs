@@ -24,19 +24,8 @@ fn name<T: Serialize>(value: &T) -> String {
 }
 
 /// The leading columns that identify a case.
-const CASE_COLUMNS: [&str; 11] = [
-    "case",
-    "ndf",
-    "alpha_x",
-    "alpha_y",
-    "height",
-    "smith",
-    "normals",
-    "material",
-    "theta_i_deg",
-    "phi_i_deg",
-    "side",
-];
+const CASE_COLUMNS: [&str; 11] =
+    ["case", "ndf", "alpha_x", "alpha_y", "height", "smith", "normals", "material", "theta_i_deg", "phi_i_deg", "side"];
 
 fn case_fields(case: &Case) -> Vec<String> {
     vec![
@@ -64,11 +53,7 @@ fn hemisphere_sign(side: IncidentSide, hemisphere: Hemisphere) -> f64 {
 }
 
 fn hemispheres(case: &Case) -> &'static [Hemisphere] {
-    if case.material.transmits() {
-        &[Hemisphere::R, Hemisphere::T]
-    } else {
-        &[Hemisphere::R]
-    }
+    if case.material.transmits() { &[Hemisphere::R, Hemisphere::T] } else { &[Hemisphere::R] }
 }
 
 /// Energy accounting of one case, per channel (§9.2).
@@ -124,11 +109,7 @@ impl EnergyBalance {
     }
 
     pub fn lost(&self) -> f64 {
-        self.lost_trapped
-            .iter()
-            .chain(&self.lost_invalid)
-            .chain(&self.lost_runaway)
-            .sum()
+        self.lost_trapped.iter().chain(&self.lost_invalid).chain(&self.lost_runaway).sum()
     }
 }
 
@@ -136,11 +117,7 @@ fn channel_header(rgb: bool) -> Vec<&'static str> {
     if rgb { vec!["channel"] } else { vec![] }
 }
 
-fn lobe_rows<const C: usize>(
-    w: &mut csv::Writer<Vec<u8>>,
-    case: &Case,
-    d: &Detector<C>,
-) -> Result<()> {
+fn lobe_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Detector<C>) -> Result<()> {
     let fields = case_fields(case);
     let grid = d.grid;
     let n = d.photons;
@@ -153,8 +130,7 @@ fn lobe_rows<const C: usize>(
                 let solid = grid.projected_solid_angle(ic);
                 for ip in 0..grid.phi_bins {
                     let (phi_lo, phi_hi) = grid.phi_edges_deg(ip);
-                    let tally =
-                        &tallies.bins[hemisphere as usize * grid.bins() + ic * grid.phi_bins + ip];
+                    let tally = &tallies.bins[hemisphere as usize * grid.bins() + ic * grid.phi_bins + ip];
                     for (c, channel) in CHANNEL_NAMES.iter().enumerate().take(C) {
                         let (energy, se) = tally.mean_and_stderr(n, c);
                         let mut row = fields.clone();
@@ -163,9 +139,7 @@ fn lobe_rows<const C: usize>(
                         if C > 1 {
                             row.push(channel.to_string());
                         }
-                        row.extend(
-                            [cos_lo, cos_hi, phi_lo, phi_hi, energy, se].map(|v| v.to_string()),
-                        );
+                        row.extend([cos_lo, cos_hi, phi_lo, phi_hi, energy, se].map(|v| v.to_string()));
                         row.push(tally.count.to_string());
                         row.push((energy / solid).to_string());
                         row.push((se / solid).to_string());
@@ -178,11 +152,7 @@ fn lobe_rows<const C: usize>(
     Ok(())
 }
 
-fn summary_rows<const C: usize>(
-    w: &mut csv::Writer<Vec<u8>>,
-    case: &Case,
-    d: &Detector<C>,
-) -> Result<()> {
+fn summary_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Detector<C>) -> Result<()> {
     let fields = case_fields(case);
     let n = d.photons;
     let mut write = |order: usize, what: &str, c: usize, value: f64, se: f64, folded: bool| {
@@ -200,14 +170,7 @@ fn summary_rows<const C: usize>(
         for &hemisphere in hemispheres(case) {
             for c in 0..C {
                 let (albedo, se) = tallies.albedo[hemisphere as usize].mean_and_stderr(n, c);
-                write(
-                    slot,
-                    &format!("{hemisphere:?}"),
-                    c,
-                    albedo,
-                    se,
-                    d.is_folded(slot),
-                )?;
+                write(slot, &format!("{hemisphere:?}"), c, albedo, se, d.is_folded(slot))?;
             }
         }
     }
@@ -215,12 +178,7 @@ fn summary_rows<const C: usize>(
         let (accounted, se) = d.accounted.mean_and_stderr(n, c);
         write(0, "absorbed", c, 1.0 - accounted, se, false)?;
         let lost: f64 = d.lost.iter().map(|t| t.mean_and_stderr(n, c).0).sum();
-        let lost_se = d
-            .lost
-            .iter()
-            .map(|t| t.mean_and_stderr(n, c).1.powi(2))
-            .sum::<f64>()
-            .sqrt();
+        let lost_se = d.lost.iter().map(|t| t.mean_and_stderr(n, c).1.powi(2)).sum::<f64>().sqrt();
         write(0, "lost", c, lost, lost_se, false)?;
     }
     Ok(())
@@ -306,10 +264,7 @@ pub fn run_json(sim: &Simulation, config: &Config) -> Result<Vec<u8>> {
             .cases
             .iter()
             .zip(&sim.results)
-            .map(|(case, r)| CaseReport {
-                case,
-                energy: EnergyBalance::from_result(r),
-            })
+            .map(|(case, r)| CaseReport { case, energy: EnergyBalance::from_result(r) })
             .collect(),
     };
     let mut text = serde_json::to_vec_pretty(&report)?;
@@ -331,18 +286,10 @@ fn make_readable(_file: &std::fs::File) -> std::io::Result<()> {
 
 /// Makes sure `dir` exists and is writable, before any simulation time is spent.
 pub fn prepare_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| {
-        format!(
-            "--out {}: cannot create the output directory",
-            dir.display()
-        )
-    })?;
-    tempfile::NamedTempFile::new_in(dir).with_context(|| {
-        format!(
-            "--out {}: the output directory is not writable",
-            dir.display()
-        )
-    })?;
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("--out {}: cannot create the output directory", dir.display()))?;
+    tempfile::NamedTempFile::new_in(dir)
+        .with_context(|| format!("--out {}: the output directory is not writable", dir.display()))?;
     Ok(())
 }
 
@@ -353,19 +300,14 @@ pub fn write_atomically(dir: &Path, files: &[(&str, Vec<u8>)]) -> Result<Vec<Pat
     for (file, bytes) in files {
         let mut tmp = tempfile::NamedTempFile::new_in(dir)
             .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
-        tmp.write_all(bytes)
-            .with_context(|| format!("cannot write {file}"))?;
-        make_readable(tmp.as_file())
-            .with_context(|| format!("cannot set the permissions of {file}"))?;
-        tmp.as_file()
-            .sync_all()
-            .with_context(|| format!("cannot write {file}"))?;
+        tmp.write_all(bytes).with_context(|| format!("cannot write {file}"))?;
+        make_readable(tmp.as_file()).with_context(|| format!("cannot set the permissions of {file}"))?;
+        tmp.as_file().sync_all().with_context(|| format!("cannot write {file}"))?;
         staged.push((tmp, dir.join(file)));
     }
     let mut written = Vec::new();
     for (tmp, path) in staged {
-        tmp.persist(&path)
-            .with_context(|| format!("cannot rename into {}", path.display()))?;
+        tmp.persist(&path).with_context(|| format!("cannot rename into {}", path.display()))?;
         written.push(path);
     }
     Ok(written)

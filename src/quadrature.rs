@@ -24,12 +24,8 @@ const WK: [f64; 8] = [
     0.209_482_141_084_727_8,
 ];
 /// Gauss weights of the 7-point rule, on the odd Kronrod abscissae `XK[1], XK[3], XK[5], XK[7]`.
-const WG: [f64; 4] = [
-    0.129_484_966_168_869_7,
-    0.279_705_391_489_276_7,
-    0.381_830_050_505_118_9,
-    0.417_959_183_673_469_4,
-];
+const WG: [f64; 4] =
+    [0.129_484_966_168_869_7, 0.279_705_391_489_276_7, 0.381_830_050_505_118_9, 0.417_959_183_673_469_4];
 
 /// One Gauss–Kronrod panel: the Kronrod estimate and |Kronrod - Gauss|.
 fn panel(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
@@ -52,14 +48,7 @@ fn panel(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
 /// `∫_a^b f` by adaptive bisection until each panel's error estimate is below its share of
 /// `abs_tol` (or a depth of 50 halvings). Returns the integral and the summed error estimate.
 pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, abs_tol: f64) -> (f64, f64) {
-    fn recurse(
-        f: &impl Fn(f64) -> f64,
-        a: f64,
-        b: f64,
-        tol: f64,
-        whole: (f64, f64),
-        depth: u32,
-    ) -> (f64, f64) {
+    fn recurse(f: &impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, whole: (f64, f64), depth: u32) -> (f64, f64) {
         let (value, err) = whole;
         if err <= tol || depth >= 50 {
             return (value, err);
@@ -77,19 +66,9 @@ pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, abs_tol: f64) -> (f64, 
 
 /// `∫_{x0}^{x1} ∫_{y0}^{y1} f(x, y) dy dx` by nested adaptive quadrature; the inner integrals
 /// get a tolerance scaled to the outer interval.
-pub fn integrate_2d(
-    f: impl Fn(f64, f64) -> f64,
-    x: (f64, f64),
-    y: (f64, f64),
-    abs_tol: f64,
-) -> (f64, f64) {
+pub fn integrate_2d(f: impl Fn(f64, f64) -> f64, x: (f64, f64), y: (f64, f64), abs_tol: f64) -> (f64, f64) {
     let inner_tol = abs_tol / (x.1 - x.0).abs().max(1e-300) * 0.1;
-    integrate(
-        |xv| integrate(|yv| f(xv, yv), y.0, y.1, inner_tol).0,
-        x.0,
-        x.1,
-        abs_tol,
-    )
+    integrate(|xv| integrate(|yv| f(xv, yv), y.0, y.1, inner_tol).0, x.0, x.1, abs_tol)
 }
 
 #[cfg(test)]
@@ -116,12 +95,7 @@ mod tests {
     #[test]
     fn two_dimensional_gaussian() {
         // ∫∫_{[-5,5]^2} e^{-x^2-y^2} = pi erf(5)^2.
-        let (v, _) = integrate_2d(
-            |x, y| (-x * x - y * y).exp(),
-            (-5.0, 5.0),
-            (-5.0, 5.0),
-            1e-12,
-        );
+        let (v, _) = integrate_2d(|x, y| (-x * x - y * y).exp(), (-5.0, 5.0), (-5.0, 5.0), 1e-12);
         let e5 = statrs::function::erf::erf(5.0);
         assert!((v - std::f64::consts::PI * e5 * e5).abs() < 1e-9, "{v}");
     }

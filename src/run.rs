@@ -35,15 +35,9 @@ impl RunSettings {
         Self {
             paths: config.paths,
             seed: config.seed,
-            grid: Grid {
-                cos_bins: config.detector.cos_theta_bins,
-                phi_bins: config.detector.phi_bins,
-            },
+            grid: Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins },
             max_order: config.detector.max_order,
-            policy: EnergyPolicy {
-                split: config.energy.split,
-                threshold: config.energy.threshold,
-            },
+            policy: EnergyPolicy { split: config.energy.split, threshold: config.energy.threshold },
         }
     }
 
@@ -95,15 +89,10 @@ fn with_ndf<const C: usize>(
     pool: &rayon::ThreadPool,
     progress: &ProgressBar,
 ) -> Detector<C> {
-    let roughness = Roughness {
-        x: case.alpha_x,
-        y: case.alpha_y,
-    };
+    let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
     match case.ndf {
         NdfKind::Ggx => with_surface::<Ggx, C>(Ggx(roughness), case, settings, pool, progress),
-        NdfKind::Beckmann => {
-            with_surface::<Beckmann, C>(Beckmann(roughness), case, settings, pool, progress)
-        }
+        NdfKind::Beckmann => with_surface::<Beckmann, C>(Beckmann(roughness), case, settings, pool, progress),
     }
 }
 
@@ -124,17 +113,7 @@ fn with_surface<N: Ndf, const C: usize>(
         NormalsKind::Vndf => Normals::Visible,
         NormalsKind::HammonRejection => Normals::HammonRejection,
     };
-    with_material(
-        &Microsurface {
-            ndf,
-            smith,
-            normals,
-        },
-        case,
-        settings,
-        pool,
-        progress,
-    )
+    with_material(&Microsurface { ndf, smith, normals }, case, settings, pool, progress)
 }
 
 fn with_material<N: Ndf, const C: usize>(
@@ -145,61 +124,29 @@ fn with_material<N: Ndf, const C: usize>(
     progress: &ProgressBar,
 ) -> Detector<C> {
     match &case.material {
-        MaterialConfig::Conductor {
-            fresnel,
-            f0,
-            eta,
-            k,
-            ..
-        } => {
+        MaterialConfig::Conductor { fresnel, f0, eta, k, .. } => {
             let fresnel = match fresnel {
                 FresnelKind::None => ConductorFresnel::None,
                 FresnelKind::Schlick => ConductorFresnel::Schlick { f0: channels(f0) },
-                FresnelKind::Exact => ConductorFresnel::Exact {
-                    eta: channels(eta),
-                    k: channels(k),
-                },
+                FresnelKind::Exact => ConductorFresnel::Exact { eta: channels(eta), k: channels(k) },
             };
-            run_chunks(
-                surface,
-                &Conductor { fresnel },
-                case,
-                settings,
-                pool,
-                progress,
-            )
+            run_chunks(surface, &Conductor { fresnel }, case, settings, pool, progress)
         }
-        MaterialConfig::Dielectric { eta, .. } => run_chunks(
-            surface,
-            &Dielectric { eta: *eta },
-            case,
-            settings,
-            pool,
-            progress,
-        ),
-        MaterialConfig::Diffuse { albedo, .. } => run_chunks(
-            surface,
-            &Lambertian {
-                albedo: albedo.to_array(),
-            },
-            case,
-            settings,
-            pool,
-            progress,
-        ),
+        MaterialConfig::Dielectric { eta, .. } => {
+            run_chunks(surface, &Dielectric { eta: *eta }, case, settings, pool, progress)
+        }
+        MaterialConfig::Diffuse { albedo, .. } => {
+            run_chunks(surface, &Lambertian { albedo: albedo.to_array() }, case, settings, pool, progress)
+        }
         MaterialConfig::Hammon { f0, albedo, .. } => {
-            let facet = Hammon {
-                f0: f0.to_array(),
-                albedo: albedo.to_array(),
-            };
+            let facet = Hammon { f0: f0.to_array(), albedo: albedo.to_array() };
             run_chunks(surface, &facet, case, settings, pool, progress)
         }
     }
 }
 
 fn channels<const C: usize>(c: &Option<crate::config::Channels>) -> [f64; C] {
-    c.expect("validated: the Fresnel mode's parameters are present")
-        .to_array()
+    c.expect("validated: the Fresnel mode's parameters are present").to_array()
 }
 
 /// Runs every chunk of a case on the pool: each worker takes the next chunk index from a
@@ -230,23 +177,14 @@ where
             let photons = CHUNK.min(settings.paths - chunk * CHUNK);
             let mut rng = chunk_rng(settings.seed, case.index, chunk);
             for _ in 0..photons {
-                surface.trace(
-                    facet,
-                    &settings.policy,
-                    wi,
-                    &mut rng,
-                    &mut stack,
-                    &mut detector,
-                );
+                surface.trace(facet, &settings.policy, wi, &mut rng, &mut stack, &mut detector);
                 detector.end_photon();
             }
             progress.inc(photons);
         }
     });
     let mut partials = partials.into_iter();
-    let mut total = partials
-        .next()
-        .unwrap_or_else(|| Detector::new(settings.grid, wi, settings.max_order));
+    let mut total = partials.next().unwrap_or_else(|| Detector::new(settings.grid, wi, settings.max_order));
     for p in partials {
         total.merge(&p);
     }

@@ -42,17 +42,8 @@ impl ChiSquare {
     fn from_cells(cells: Vec<Cell>) -> Self {
         let statistic: f64 = cells.iter().map(|c| c.z * c.z).sum();
         let dof = cells.len();
-        let p_value = if dof == 0 {
-            1.0
-        } else {
-            ChiSquared::new(dof as f64).map_or(f64::NAN, |d| d.sf(statistic))
-        };
-        Self {
-            statistic,
-            dof,
-            p_value,
-            cells,
-        }
+        let p_value = if dof == 0 { 1.0 } else { ChiSquared::new(dof as f64).map_or(f64::NAN, |d| d.sf(statistic)) };
+        Self { statistic, dof, p_value, cells }
     }
 
     /// The observed and expected table of the `n` cells with the largest |z|, for failure reports.
@@ -64,16 +55,8 @@ impl ChiSquare {
             self.statistic, self.dof, self.p_value
         );
         for c in cells.into_iter().take(n) {
-            let bins = if c.bins.len() == 1 {
-                c.bins[0].to_string()
-            } else {
-                format!("pool({})", c.bins.len())
-            };
-            let _ = writeln!(
-                out,
-                "{bins:>7} {:>15.6e} {:>15.6e} {:>7.2}",
-                c.observed, c.expected, c.z
-            );
+            let bins = if c.bins.len() == 1 { c.bins[0].to_string() } else { format!("pool({})", c.bins.len()) };
+            let _ = writeln!(out, "{bins:>7} {:>15.6e} {:>15.6e} {:>7.2}", c.observed, c.expected, c.z);
         }
         out
     }
@@ -89,23 +72,12 @@ pub fn sidak(family: f64, tests: usize) -> f64 {
 /// Bins whose expected photon count `N mu / r` is below `min_count` are pooled into one cell;
 /// the pooled cell is tested too if its own expected count reaches `min_count`.
 /// Degrees of freedom: the number of cells (the bins need not hold all the light).
-pub fn chi_square(
-    observed: &[WeightedBin],
-    expected: &[f64],
-    photons: u64,
-    min_count: f64,
-) -> ChiSquare {
+pub fn chi_square(observed: &[WeightedBin], expected: &[f64], photons: u64, min_count: f64) -> ChiSquare {
     let n = photons as f64;
-    let (s_all, q_all) = observed
-        .iter()
-        .fold((0.0, 0.0), |(s, q), b| (s + b.mean, q + b.second_moment));
+    let (s_all, q_all) = observed.iter().fold((0.0, 0.0), |(s, q), b| (s + b.mean, q + b.second_moment));
     let global_ratio = if s_all > 0.0 { q_all / s_all } else { 1.0 };
     let ratio = |b: &WeightedBin| {
-        if b.mean > 0.0 {
-            b.second_moment / b.mean
-        } else {
-            global_ratio
-        }
+        if b.mean > 0.0 { b.second_moment / b.mean } else { global_ratio }
     };
     let mut cells = Vec::new();
     let mut pool = (Vec::new(), 0.0, 0.0, 0.0);
@@ -113,12 +85,7 @@ pub fn chi_square(
         let r = ratio(b);
         let var_n = mu * r - mu * mu;
         if n * mu / r >= min_count {
-            cells.push(Cell {
-                bins: vec![i],
-                observed: b.mean,
-                expected: mu,
-                z: (b.mean - mu) / (var_n / n).sqrt(),
-            });
+            cells.push(Cell { bins: vec![i], observed: b.mean, expected: mu, z: (b.mean - mu) / (var_n / n).sqrt() });
         } else {
             pool.0.push(i);
             pool.1 += b.mean;
@@ -129,12 +96,7 @@ pub fn chi_square(
     let (bins, obs, mu, mu_r) = pool;
     if !bins.is_empty() && n * mu / (mu_r / mu.max(1e-300)) >= min_count {
         let var_n = mu_r - mu * mu;
-        cells.push(Cell {
-            bins,
-            observed: obs,
-            expected: mu,
-            z: (obs - mu) / (var_n / n).sqrt(),
-        });
+        cells.push(Cell { bins, observed: obs, expected: mu, z: (obs - mu) / (var_n / n).sqrt() });
     }
     ChiSquare::from_cells(cells)
 }
@@ -142,39 +104,15 @@ pub fn chi_square(
 /// Two-sample chi-square of two independent weighted histograms of the same quantity, with
 /// `n1` and `n2` photons: `z = (m1 - m2) / sqrt(v1 + v2)` per cell with per-photon variances;
 /// bins with fewer than `min_count` photons in the two samples together are pooled.
-pub fn two_sample(
-    a: &[WeightedBin],
-    n1: u64,
-    b: &[WeightedBin],
-    n2: u64,
-    counts: &[u64],
-    min_count: u64,
-) -> ChiSquare {
-    let var = |bin: &WeightedBin, n: f64| {
-        ((bin.second_moment - bin.mean * bin.mean) / (n - 1.0)).max(0.0)
-    };
+pub fn two_sample(a: &[WeightedBin], n1: u64, b: &[WeightedBin], n2: u64, counts: &[u64], min_count: u64) -> ChiSquare {
+    let var = |bin: &WeightedBin, n: f64| ((bin.second_moment - bin.mean * bin.mean) / (n - 1.0)).max(0.0);
     let (n1, n2) = (n1 as f64, n2 as f64);
     let mut cells = Vec::new();
-    let mut pooled = (
-        Vec::new(),
-        WeightedBin {
-            mean: 0.0,
-            second_moment: 0.0,
-        },
-        WeightedBin {
-            mean: 0.0,
-            second_moment: 0.0,
-        },
-        0,
-    );
+    let mut pooled =
+        (Vec::new(), WeightedBin { mean: 0.0, second_moment: 0.0 }, WeightedBin { mean: 0.0, second_moment: 0.0 }, 0);
     let cell = |bins: Vec<usize>, x: &WeightedBin, y: &WeightedBin| {
         let v = var(x, n1) + var(y, n2);
-        Cell {
-            bins,
-            observed: x.mean,
-            expected: y.mean,
-            z: (x.mean - y.mean) / v.sqrt(),
-        }
+        Cell { bins, observed: x.mean, expected: y.mean, z: (x.mean - y.mean) / v.sqrt() }
     };
     for (i, ((x, y), &count)) in a.iter().zip(b).zip(counts).enumerate() {
         if count >= min_count {
@@ -210,22 +148,13 @@ mod tests {
         // Multinomial counts 1000 photons over 4 bins with exact probabilities: the statistic of
         // exact expectations equals Pearson's sum; a 10% shifted model must be rejected.
         let counts = [400.0, 300.0, 200.0, 100.0];
-        let obs: Vec<WeightedBin> = counts
-            .iter()
-            .map(|c| WeightedBin {
-                mean: c / 1000.0,
-                second_moment: c / 1000.0,
-            })
-            .collect();
+        let obs: Vec<WeightedBin> =
+            counts.iter().map(|c| WeightedBin { mean: c / 1000.0, second_moment: c / 1000.0 }).collect();
         let right = chi_square(&obs, &[0.4, 0.3, 0.2, 0.1], 1000, 5.0);
         assert_eq!(right.statistic, 0.0);
         let wrong = chi_square(&obs, &[0.3, 0.3, 0.3, 0.1], 1000, 5.0);
         // Pearson by hand: 1000 * (0.01/0.21 + 0.01/0.21) = 95.238...
-        assert!(
-            (wrong.statistic - 1000.0 * 2.0 * 0.01 / 0.21).abs() < 1e-9,
-            "{}",
-            wrong.statistic
-        );
+        assert!((wrong.statistic - 1000.0 * 2.0 * 0.01 / 0.21).abs() < 1e-9, "{}", wrong.statistic);
         assert!(wrong.p_value < 1e-15);
     }
 }

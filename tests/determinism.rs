@@ -36,10 +36,7 @@ fn outputs(threads: usize, dir: &Path) -> (Vec<u8>, Vec<u8>) {
     let config = Config::parse(CONFIG).unwrap();
     let sim = smithwalk::simulate(&config, Some(threads), false).unwrap();
     smithwalk::write_outputs(&sim, &config, dir).unwrap();
-    (
-        std::fs::read(dir.join("lobes.csv")).unwrap(),
-        std::fs::read(dir.join("summary.csv")).unwrap(),
-    )
+    (std::fs::read(dir.join("lobes.csv")).unwrap(), std::fs::read(dir.join("summary.csv")).unwrap())
 }
 
 #[test]
@@ -48,10 +45,7 @@ fn one_and_two_threads_give_identical_files() {
     let one = outputs(1, a.path());
     let two = outputs(2, b.path());
     assert!(one.0 == two.0, "lobes.csv differs between 1 and 2 threads");
-    assert!(
-        one.1 == two.1,
-        "summary.csv differs between 1 and 2 threads"
-    );
+    assert!(one.1 == two.1, "summary.csv differs between 1 and 2 threads");
     // The run is RGB with splitting: the channel column is there and nothing is NaN or inf.
     let text = String::from_utf8(one.0).unwrap();
     assert!(text.lines().next().unwrap().contains(",channel,"));
@@ -59,13 +53,11 @@ fn one_and_two_threads_give_identical_files() {
 }
 
 fn smithwalk(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_smithwalk"))
-        .args(args)
-        .output()
-        .expect("binary runs")
+    Command::new(env!("CARGO_BIN_EXE_smithwalk")).args(args).output().expect("binary runs")
 }
 
-const GOOD: &str = "paths = 1000\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 30\n";
+const GOOD: &str =
+    "paths = 1000\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 30\n";
 
 /// Runs the CLI on a config with `from` replaced by `to`; expects a failure mentioning every
 /// string of `expect` and no output file.
@@ -76,166 +68,87 @@ fn rejects(from: &str, to: &str, expect: &[&str]) {
     assert_ne!(text, GOOD, "replacement {from:?} did not apply");
     std::fs::write(&config, text).unwrap();
     let out = dir.path().join("out");
-    let result = smithwalk(&[
-        "run",
-        config.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let result = smithwalk(&["run", config.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&result.stderr);
     assert!(!result.status.success(), "{from} -> {to}: accepted");
     for e in expect {
-        assert!(
-            stderr.contains(e),
-            "{from} -> {to}: error {stderr:?} does not mention {e:?}"
-        );
+        assert!(stderr.contains(e), "{from} -> {to}: error {stderr:?} does not mention {e:?}");
     }
-    assert_eq!(
-        stderr.matches("error:").count(),
-        1,
-        "one error expected, got {stderr:?}"
-    );
-    assert!(
-        !out.exists() || std::fs::read_dir(&out).unwrap().next().is_none(),
-        "output written for a bad config"
-    );
+    assert_eq!(stderr.matches("error:").count(), 1, "one error expected, got {stderr:?}");
+    assert!(!out.exists() || std::fs::read_dir(&out).unwrap().next().is_none(), "output written for a bad config");
 }
 
-#[test]
-fn bad_input_is_rejected_with_a_clear_error_and_no_output() {
-    rejects("paths = 1000\n", "", &["missing field `paths`"]);
-    rejects(
-        "[surface]",
-        "colour = 3\n[surface]",
-        &["unknown field `colour`"],
-    );
-    rejects(
-        "alpha = 0.5",
-        "alpha = -0.5",
-        &["surface.alpha", "-0.5", "> 0"],
-    );
-    rejects(
-        "alpha = 0.5",
-        "alpha = [0.5, 0.0]",
-        &["surface.alpha", "0", "> 0"],
-    );
-    rejects(
-        "alpha = 0.5",
-        "alpha = []",
-        &["surface.alpha", "at least one value"],
-    );
-    rejects(
-        "kind = \"conductor\"",
-        "kind = \"dielectric\"\neta = -1.5",
-        &["material[0].eta", "-1.5", "> 0"],
-    );
-    rejects(
-        "kind = \"conductor\"",
-        "kind = \"dielectric\"\neta = 1.0",
-        &["material[0].eta", "!= 1"],
-    );
-    rejects(
+/// (text to replace in a good config, its replacement, what the error must mention)
+const BAD_INPUT: [(&str, &str, &[&str]); 15] = [
+    ("paths = 1000\n", "", &["missing field `paths`"]),
+    ("[surface]", "colour = 3\n[surface]", &["unknown field `colour`"]),
+    ("alpha = 0.5", "alpha = -0.5", &["surface.alpha", "-0.5", "> 0"]),
+    ("alpha = 0.5", "alpha = [0.5, 0.0]", &["surface.alpha", "0", "> 0"]),
+    ("alpha = 0.5", "alpha = []", &["surface.alpha", "at least one value"]),
+    ("kind = \"conductor\"", "kind = \"dielectric\"\neta = -1.5", &["material[0].eta", "-1.5", "> 0"]),
+    ("kind = \"conductor\"", "kind = \"dielectric\"\neta = 1.0", &["material[0].eta", "!= 1"]),
+    (
         "kind = \"conductor\"",
         "kind = \"conductor\"\nfresnel = \"exact\"",
         &["material[0].eta", "missing", "needs `eta`"],
-    );
-    rejects(
-        "theta_deg = 30",
-        "theta_deg = 90",
-        &["incident.theta_deg", "90", "[0, 90)"],
-    );
-    rejects(
-        "theta_deg = 30",
-        "theta_deg = -1",
-        &["incident.theta_deg", "-1"],
-    );
-    rejects(
-        "theta_deg = 30",
-        "theta_deg = []",
-        &["incident.theta_deg", "at least one"],
-    );
-    rejects(
-        "theta_deg = 30",
-        "theta_deg = 30\nside = \"inside\"",
-        &["incident.side", "dielectric"],
-    );
-    rejects(
+    ),
+    ("theta_deg = 30", "theta_deg = 90", &["incident.theta_deg", "90", "[0, 90)"]),
+    ("theta_deg = 30", "theta_deg = -1", &["incident.theta_deg", "-1"]),
+    ("theta_deg = 30", "theta_deg = []", &["incident.theta_deg", "at least one"]),
+    ("theta_deg = 30", "theta_deg = 30\nside = \"inside\"", &["incident.side", "dielectric"]),
+    (
         "theta_deg = 30\n",
         "theta_deg = 30\n[detector]\ncos_theta_bins = 0\n",
         &["detector.cos_theta_bins", "0", "1 to 4096"],
-    );
-    rejects(
-        "theta_deg = 30\n",
-        "theta_deg = 30\n[detector]\nphi_bins = 0\n",
-        &["detector.phi_bins", "0"],
-    );
-    rejects(
-        "theta_deg = 30\n",
-        "theta_deg = 30\n[energy]\nthreshold = 0.0\n",
-        &["energy.threshold", "0"],
-    );
+    ),
+    ("theta_deg = 30\n", "theta_deg = 30\n[detector]\nphi_bins = 0\n", &["detector.phi_bins", "0"]),
+    ("theta_deg = 30\n", "theta_deg = 30\n[energy]\nthreshold = 0.0\n", &["energy.threshold", "0"]),
+];
+
+#[test]
+fn bad_input_is_rejected_with_a_clear_error_and_no_output() {
+    for (from, to, expect) in BAD_INPUT {
+        rejects(from, to, expect);
+    }
+}
+
+/// A temporary directory holding a valid config file.
+fn good_config() -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("good.toml");
+    std::fs::write(&config, GOOD).unwrap();
+    (dir, config)
 }
 
 #[test]
 fn unwritable_output_directory_is_rejected_before_running() {
-    let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("good.toml");
-    std::fs::write(&config, GOOD).unwrap();
+    let (dir, config) = good_config();
     // A regular file where the output directory should be.
     let blocker = dir.path().join("blocker");
     std::fs::write(&blocker, "").unwrap();
     let out = blocker.join("out");
-    let result = smithwalk(&[
-        "run",
-        config.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let result = smithwalk(&["run", config.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&result.stderr);
     assert!(!result.status.success());
-    assert!(
-        stderr.contains("--out") && stderr.contains("blocker"),
-        "{stderr}"
-    );
+    assert!(stderr.contains("--out") && stderr.contains("blocker"), "{stderr}");
 }
 
 #[test]
 fn a_good_run_writes_all_three_files() {
-    let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("good.toml");
-    std::fs::write(&config, GOOD).unwrap();
+    let (dir, config) = good_config();
     let out = dir.path().join("out");
-    let result = smithwalk(&[
-        "run",
-        config.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--threads",
-        "1",
-        "--seed",
-        "3",
-    ]);
-    assert!(
-        result.status.success(),
-        "{}",
-        String::from_utf8_lossy(&result.stderr)
-    );
+    let result =
+        smithwalk(&["run", config.to_str().unwrap(), "--out", out.to_str().unwrap(), "--threads", "1", "--seed", "3"]);
+    assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
     for f in ["lobes.csv", "summary.csv", "run.json"] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     let leftovers: Vec<_> = std::fs::read_dir(&out)
         .unwrap()
-        .filter(|e| {
-            e.as_ref()
-                .unwrap()
-                .file_name()
-                .to_string_lossy()
-                .starts_with(".tmp")
-        })
+        .filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().starts_with(".tmp"))
         .collect();
     assert!(leftovers.is_empty(), "temporary files left behind");
-    let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("run.json")).unwrap()).unwrap();
     assert_eq!(json["seed"], 3);
     assert_eq!(json["paths"], 1000);
 }

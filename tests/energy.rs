@@ -39,15 +39,9 @@ fn white_furnace() {
             );
             assert_eq!(e.lost(), 0.0, "{label}: weight lost {e:?}");
             let (absorbed, se) = (e.absorbed[0], e.absorbed_stderr[0]);
-            assert!(
-                absorbed.abs() <= 4.0 * se + 1e-12,
-                "{label}: absorbed {absorbed} +- {se}"
-            );
+            assert!(absorbed.abs() <= 4.0 * se + 1e-12, "{label}: absorbed {absorbed} +- {se}");
             let r_plus_t = e.reflected[0] + e.transmitted[0];
-            assert!(
-                (r_plus_t - 1.0).abs() <= 4.0 * se + 1e-12,
-                "{label}: R + T = {r_plus_t} +- {se}"
-            );
+            assert!((r_plus_t - 1.0).abs() <= 4.0 * se + 1e-12, "{label}: R + T = {r_plus_t} +- {se}");
             if !case.material.transmits() {
                 assert_eq!(e.transmitted[0], 0.0, "{label}");
             }
@@ -56,13 +50,7 @@ fn white_furnace() {
 }
 
 /// Checks measured per-order albedos against a reference row.
-fn check_orders(
-    toml: &str,
-    hemisphere: Hemisphere,
-    reference: &[f64],
-    ref_photons: f64,
-    label: &str,
-) {
+fn check_orders(toml: &str, hemisphere: Hemisphere, reference: &[f64], ref_photons: f64, label: &str) {
     let sim = simulate(toml, 2);
     let d = mono(&sim, 0);
     for (k, &r) in reference.iter().enumerate() {
@@ -70,11 +58,7 @@ fn check_orders(
         let se_ref = (r * (1.0 - r) / ref_photons).sqrt();
         let rounding: f64 = 5e-5 / 3f64.sqrt();
         let tol = 4.0 * (se * se + se_ref * se_ref + rounding * rounding).sqrt();
-        assert!(
-            (e - r).abs() <= tol,
-            "{label} E{}: {e:.5} +- {se:.5}, reference {r} (tol {tol:.5})",
-            k + 1
-        );
+        assert!((e - r).abs() <= tol, "{label} E{}: {e:.5} +- {se:.5}, reference {r} (tol {tol:.5})", k + 1);
     }
 }
 
@@ -96,13 +80,7 @@ fn conductor_per_order_albedos() {
             "paths = 2_000_000\nseed = {}\n[surface]\nalpha = {alpha}\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 8\n",
             300 + i
         );
-        check_orders(
-            &toml,
-            Hemisphere::R,
-            &row,
-            2e6,
-            &format!("conductor alpha {alpha} theta {theta}"),
-        );
+        check_orders(&toml, Hemisphere::R, &row, 2e6, &format!("conductor alpha {alpha} theta {theta}"));
     }
 }
 
@@ -120,13 +98,7 @@ fn lambertian_per_order_albedos() {
             "paths = 1_000_000\nseed = {}\n[surface]\nalpha = {alpha}\n[material]\nkind = \"diffuse\"\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 8\n",
             400 + i
         );
-        check_orders(
-            &toml,
-            Hemisphere::R,
-            &row,
-            1e6,
-            &format!("lambertian alpha {alpha} theta {theta}"),
-        );
+        check_orders(&toml, Hemisphere::R, &row, 1e6, &format!("lambertian alpha {alpha} theta {theta}"));
     }
 }
 
@@ -149,12 +121,9 @@ fn dielectric_reflection_and_transmission() {
         let sim = simulate(&toml, 2);
         let d = mono(&sim, 0);
         let rounding: f64 = 5e-5 / 3f64.sqrt();
-        for (slot, h, reference) in [
-            (0, Hemisphere::R, r),
-            (0, Hemisphere::T, t),
-            (1, Hemisphere::R, r1),
-            (1, Hemisphere::T, t1),
-        ] {
+        for (slot, h, reference) in
+            [(0, Hemisphere::R, r), (0, Hemisphere::T, t), (1, Hemisphere::R, r1), (1, Hemisphere::T, t1)]
+        {
             let (e, se) = albedo(d, slot, h);
             let se_ref = (reference * (1.0 - reference) / 1e6).sqrt();
             let tol = 4.0 * (se * se + se_ref * se_ref + rounding * rounding).sqrt();
@@ -180,10 +149,7 @@ fn constant_fresnel_and_albedo_scale_each_order() {
     for k in 1..5 {
         let (a, _) = albedo(mono(&one, 0), k, Hemisphere::R);
         let (b, _) = albedo(mono(&half, 0), k, Hemisphere::R);
-        assert!(
-            (b - a * 0.5f64.powi(k as i32)).abs() < 1e-12,
-            "order {k}: {b} vs {a} * 0.5^{k}"
-        );
+        assert!((b - a * 0.5f64.powi(k as i32)).abs() < 1e-12, "order {k}: {b} vs {a} * 0.5^{k}");
     }
 }
 
@@ -232,10 +198,7 @@ max_order = 3
         // probability F / threshold: unbiased, but so rare at 20 000 photons that the sample
         // misses up to ~1e-5 of energy that the per-photon SE cannot see (with split = false
         // the balance is exact; measured).
-        assert!(
-            (total - 1.0).abs() <= 4.0 * e.absorbed_stderr[0] + 1e-5,
-            "{label}: R + T = {total}"
-        );
+        assert!((total - 1.0).abs() <= 4.0 * e.absorbed_stderr[0] + 1e-5, "{label}: R + T = {total}");
     }
     let others = r#"
 paths = 20_000
@@ -261,10 +224,7 @@ theta_deg = [0, 89.99]
         let e = EnergyBalance::from_result(result);
         assert_eq!(e.lost(), 0.0, "{}: {e:?}", case.material.label());
         for c in 0..3 {
-            assert!(
-                e.reflected[c].is_finite()
-                    && (0.0..=1.0 + 4.0 * e.absorbed_stderr[c]).contains(&e.reflected[c])
-            );
+            assert!(e.reflected[c].is_finite() && (0.0..=1.0 + 4.0 * e.absorbed_stderr[c]).contains(&e.reflected[c]));
         }
     }
 }
@@ -284,13 +244,6 @@ fn nearly_smooth_surfaces_approach_the_fresnel_mirror() {
     let (r1, se) = albedo(dielectric, 1, Hemisphere::R);
     let (t1, _) = albedo(dielectric, 1, Hemisphere::T);
     let f = microsurface::fresnel::dielectric(1.5, c);
-    assert!(
-        (r1 - f).abs() < 4.0 * se + 1e-3,
-        "dielectric R1 = {r1} +- {se}, Fresnel {f}"
-    );
-    assert!(
-        (t1 - (1.0 - f)).abs() < 4.0 * se + 1e-3,
-        "dielectric T1 = {t1}, 1 - Fresnel {}",
-        1.0 - f
-    );
+    assert!((r1 - f).abs() < 4.0 * se + 1e-3, "dielectric R1 = {r1} +- {se}, Fresnel {f}");
+    assert!((t1 - (1.0 - f)).abs() < 4.0 * se + 1e-3, "dielectric T1 = {t1}, 1 - Fresnel {}", 1.0 - f);
 }

@@ -38,39 +38,22 @@ fn symmetric_lambda_kills_single_scattering_at_normal_incidence() {
     ];
     for (i, (alpha, theta, reference)) in table.into_iter().enumerate() {
         let (e, se, balance) = e1("smith = \"symmetric\"", alpha, theta, 600 + i as u64);
-        assert!(
-            close(e, se, reference),
-            "alpha {alpha} theta {theta}: E1 = {e} +- {se}, reference {reference}"
-        );
+        assert!(close(e, se, reference), "alpha {alpha} theta {theta}: E1 = {e} +- {se}, reference {reference}");
         // Every unit of energy is accounted for: escaped or lost (trapped), none invalid.
         assert_eq!(balance.lost_invalid[0], 0.0);
         let total = balance.reflected[0] + balance.lost();
-        assert!(
-            (total - 1.0).abs() < 1e-12,
-            "alpha {alpha} theta {theta}: escaped + lost = {total}"
-        );
+        assert!((total - 1.0).abs() < 1e-12, "alpha {alpha} theta {theta}: escaped + lost = {total}");
     }
 }
 
 #[test]
 fn hammon_rejection_normals_change_single_scattering() {
     // (theta, E1 with Hammon's normals) at alpha 0.5 from §3.3 item 2.
-    let table = [
-        (10.0, 0.6841),
-        (30.0, 0.6630),
-        (60.0, 0.6134),
-        (80.0, 0.6896),
-    ];
+    let table = [(10.0, 0.6841), (30.0, 0.6630), (60.0, 0.6134), (80.0, 0.6896)];
     for (i, (theta, reference)) in table.into_iter().enumerate() {
         let (e, se, balance) = e1("normals = \"hammon-rejection\"", 0.5, theta, 700 + i as u64);
-        assert!(
-            close(e, se, reference),
-            "theta {theta}: E1 = {e} +- {se}, reference {reference}"
-        );
+        assert!(close(e, se, reference), "theta {theta}: E1 = {e} +- {se}, reference {reference}");
         assert_eq!(balance.lost(), 0.0);
-        assert_eq!(
-            balance.reflected[0], 1.0,
-            "white furnace with Hammon normals"
-        );
+        assert_eq!(balance.reflected[0], 1.0, "white furnace with Hammon normals");
     }
 }

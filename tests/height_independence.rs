@@ -18,19 +18,13 @@ fn csv_without_height(height: &str, file: &str) -> String {
     let dir = tempfile::tempdir().unwrap();
     smithwalk::write_outputs(&sim, &config, dir.path()).unwrap();
     let text = std::fs::read_to_string(dir.path().join(file)).unwrap();
-    assert!(
-        text.contains(&format!(",{height},")),
-        "the height law is recorded"
-    );
+    assert!(text.contains(&format!(",{height},")), "the height law is recorded");
     text.replace(&format!(",{height},"), ",HEIGHT,")
 }
 
 #[test]
 fn uniform_and_gaussian_heights_give_identical_measurements() {
     for file in ["lobes.csv", "summary.csv"] {
-        assert!(
-            csv_without_height("uniform", file) == csv_without_height("gaussian", file),
-            "{file} differs"
-        );
+        assert!(csv_without_height("uniform", file) == csv_without_height("gaussian", file), "{file} differs");
     }
 }

@@ -40,36 +40,12 @@ struct Check {
 }
 
 const CHECKS: [Check; 6] = [
-    Check {
-        u: 0.3,
-        theta: 20.0,
-        phi: 0.0,
-    },
-    Check {
-        u: 0.8,
-        theta: 70.0,
-        phi: 45.0,
-    },
-    Check {
-        u: 0.95,
-        theta: 88.0,
-        phi: 120.0,
-    },
-    Check {
-        u: 0.5,
-        theta: 110.0,
-        phi: 10.0,
-    },
-    Check {
-        u: 0.9,
-        theta: 160.0,
-        phi: 200.0,
-    },
-    Check {
-        u: 0.2,
-        theta: 92.0,
-        phi: 300.0,
-    },
+    Check { u: 0.3, theta: 20.0, phi: 0.0 },
+    Check { u: 0.8, theta: 70.0, phi: 45.0 },
+    Check { u: 0.95, theta: 88.0, phi: 120.0 },
+    Check { u: 0.5, theta: 110.0, phi: 10.0 },
+    Check { u: 0.9, theta: 160.0, phi: 200.0 },
+    Check { u: 0.2, theta: 92.0, phi: 300.0 },
 ];
 
 fn run<N: Ndf>(ndf: &N, seed: u128, level: f64) {
@@ -95,11 +71,7 @@ fn run<N: Ndf>(ndf: &N, seed: u128, level: f64) {
         if up {
             let n = FLIGHTS as f64;
             let z = (escapes as f64 - n * p) / (n * p * (1.0 - p)).sqrt();
-            assert!(
-                z.abs() < z_crit,
-                "{label}: {escapes} escapes, expected {:.1}, z = {z:.2}",
-                n * p
-            );
+            assert!(z.abs() < z_crit, "{label}: {escapes} escapes, expected {:.1}, z = {z:.2}", n * p);
         } else {
             assert_eq!(escapes, 0, "{label}: a downward ray escaped");
         }
@@ -113,33 +85,17 @@ fn run<N: Ndf>(ndf: &N, seed: u128, level: f64) {
                 c.u * q.powf(1.0 / rate)
             }
         };
-        let edges: Vec<f64> = (0..=BINS)
-            .map(|k| quantile(k as f64 / BINS as f64))
-            .collect();
+        let edges: Vec<f64> = (0..=BINS).map(|k| quantile(k as f64 / BINS as f64)).collect();
         let mut counts = [0u64; BINS];
         for x in &next {
             let k = edges.partition_point(|e| e <= x).clamp(1, BINS) - 1;
             counts[k] += 1;
         }
         let hits = next.len() as f64;
-        let observed: Vec<WeightedBin> = counts
-            .iter()
-            .map(|&k| WeightedBin {
-                mean: k as f64 / hits,
-                second_moment: k as f64 / hits,
-            })
-            .collect();
-        let test = chi_square(
-            &observed,
-            &[1.0 / BINS as f64; BINS],
-            next.len() as u64,
-            5.0,
-        );
-        assert!(
-            test.p_value > level,
-            "{label}: next-height distribution rejected\n{}",
-            test.worst_cells(BINS)
-        );
+        let observed: Vec<WeightedBin> =
+            counts.iter().map(|&k| WeightedBin { mean: k as f64 / hits, second_moment: k as f64 / hits }).collect();
+        let test = chi_square(&observed, &[1.0 / BINS as f64; BINS], next.len() as u64, 5.0);
+        assert!(test.p_value > level, "{label}: next-height distribution rejected\n{}", test.worst_cells(BINS));
     }
 }
 
@@ -173,9 +129,6 @@ fn limits_of_the_free_flight() {
     assert_eq!(other_side_depth(0.0), f64::INFINITY);
     assert_eq!(other_side_depth(f64::INFINITY), 0.0);
     for tau in [1e-9, 0.1, 0.69, 0.7, 3.0, 30.0] {
-        assert!(
-            (other_side_depth(other_side_depth(tau)) / tau - 1.0).abs() < 1e-9,
-            "tau {tau}"
-        );
+        assert!((other_side_depth(other_side_depth(tau)) / tau - 1.0).abs() < 1e-9, "tau {tau}");
     }
 }

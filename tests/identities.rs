@@ -7,9 +7,7 @@ use std::f64::consts::{PI, TAU};
 use microsurface::DVec3;
 use microsurface::facet::{hammon_exit_cdf, hammon_exit_cosine};
 use microsurface::fresnel;
-use microsurface::ndf::{
-    Beckmann, Ggx, Ndf, Roughness, beckmann_slope_marginal, ggx_slope_marginal,
-};
+use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, beckmann_slope_marginal, ggx_slope_marginal};
 use smithwalk::quadrature::{integrate, integrate_2d};
 
 fn dir(theta_deg: f64, phi_deg: f64) -> DVec3 {
@@ -59,11 +57,7 @@ fn check_ndf<N: Ndf>(ndf: &N, marginal: fn(f64, f64) -> f64, label: &str) {
         // Substitute q = mu + s / (1 - s) to map [mu, inf) to [0, 1).
         let integral = integrate(
             |s: f64| {
-                if s >= 1.0 {
-                    0.0
-                } else {
-                    tail(mu + s / (1.0 - s)) / ((1.0 - s) * (1.0 - s))
-                }
+                if s >= 1.0 { 0.0 } else { tail(mu + s / (1.0 - s)) / ((1.0 - s) * (1.0 - s)) }
             },
             0.0,
             1.0,
@@ -77,45 +71,22 @@ fn check_ndf<N: Ndf>(ndf: &N, marginal: fn(f64, f64) -> f64, label: &str) {
             ndf.lambda(w)
         );
         // §1.4: Lambda(-w) = -1 - Lambda(w).
-        assert!(
-            (ndf.lambda(-w) + 1.0 + ndf.lambda(w)).abs() < 1e-12,
-            "{label} theta {t}: full-sphere identity"
-        );
+        assert!((ndf.lambda(-w) + 1.0 + ndf.lambda(w)).abs() < 1e-12, "{label} theta {t}: full-sphere identity");
     }
 }
 
 #[test]
 fn ggx_d_lambda_and_projected_area() {
-    check_ndf(
-        &Ggx(Roughness::isotropic(0.5)),
-        ggx_slope_marginal,
-        "ggx 0.5",
-    );
-    check_ndf(
-        &Ggx(Roughness { x: 0.6, y: 0.25 }),
-        ggx_slope_marginal,
-        "ggx (0.6, 0.25)",
-    );
+    check_ndf(&Ggx(Roughness::isotropic(0.5)), ggx_slope_marginal, "ggx 0.5");
+    check_ndf(&Ggx(Roughness { x: 0.6, y: 0.25 }), ggx_slope_marginal, "ggx (0.6, 0.25)");
     check_ndf(&Ggx(Roughness::isotropic(2.0)), ggx_slope_marginal, "ggx 2");
 }
 
 #[test]
 fn beckmann_d_lambda_and_projected_area() {
-    check_ndf(
-        &Beckmann(Roughness::isotropic(0.5)),
-        beckmann_slope_marginal,
-        "beckmann 0.5",
-    );
-    check_ndf(
-        &Beckmann(Roughness { x: 0.6, y: 0.25 }),
-        beckmann_slope_marginal,
-        "beckmann (0.6, 0.25)",
-    );
-    check_ndf(
-        &Beckmann(Roughness::isotropic(2.0)),
-        beckmann_slope_marginal,
-        "beckmann 2",
-    );
+    check_ndf(&Beckmann(Roughness::isotropic(0.5)), beckmann_slope_marginal, "beckmann 0.5");
+    check_ndf(&Beckmann(Roughness { x: 0.6, y: 0.25 }), beckmann_slope_marginal, "beckmann (0.6, 0.25)");
+    check_ndf(&Beckmann(Roughness::isotropic(2.0)), beckmann_slope_marginal, "beckmann 2");
 }
 
 #[test]
@@ -125,18 +96,8 @@ fn lambda_at_the_poles_and_the_horizon() {
     let ggx = Ggx(Roughness::isotropic(0.3));
     let beck = Beckmann(Roughness::isotropic(0.3));
     for (name, l_up, l_down, a_down) in [
-        (
-            "ggx",
-            ggx.lambda(DVec3::Z),
-            ggx.lambda(-DVec3::Z),
-            ggx.projected_area(-DVec3::Z),
-        ),
-        (
-            "beckmann",
-            beck.lambda(DVec3::Z),
-            beck.lambda(-DVec3::Z),
-            beck.projected_area(-DVec3::Z),
-        ),
+        ("ggx", ggx.lambda(DVec3::Z), ggx.lambda(-DVec3::Z), ggx.projected_area(-DVec3::Z)),
+        ("beckmann", beck.lambda(DVec3::Z), beck.lambda(-DVec3::Z), beck.projected_area(-DVec3::Z)),
     ] {
         assert_eq!((l_up, l_down, a_down), (0.0, -1.0, 0.0), "{name}");
     }
@@ -161,19 +122,14 @@ fn fresnel_reference_values() {
     // The dielectric is the k = 0 conductor at every angle; grazing incidence reflects all.
     for i in 0..=20 {
         let c = i as f64 / 20.0;
-        assert!(
-            (fresnel::dielectric(1.5, c) - fresnel::conductor(1.5, 0.0, c)).abs() < 1e-12,
-            "c = {c}"
-        );
+        assert!((fresnel::dielectric(1.5, c) - fresnel::conductor(1.5, 0.0, c)).abs() < 1e-12, "c = {c}");
     }
     assert_eq!(fresnel::dielectric(1.5, 0.0), 1.0);
     // Total internal reflection from inside glass beyond the critical angle asin(1/1.5).
     let critical = (1.0f64 / 1.5).asin().cos();
     assert_eq!(fresnel::dielectric(1.0 / 1.5, critical - 1e-3), 1.0);
     assert!(fresnel::dielectric(1.0 / 1.5, critical + 1e-3) < 1.0);
-    assert!(
-        (fresnel::schlick(0.04, 1.0) - 0.04).abs() < 1e-15 && fresnel::schlick(0.04, 0.0) == 1.0
-    );
+    assert!((fresnel::schlick(0.04, 1.0) - 0.04).abs() < 1e-15 && fresnel::schlick(0.04, 0.0) == 1.0);
 }
 
 #[test]
@@ -184,19 +140,13 @@ fn hammon_exit_lobe() {
     let pdf = |c: f64| TAU * k * (1.0 - (1.0 - c).powi(5)) * c;
     assert!((integrate(pdf, 0.0, 1.0, 1e-14).0 - 1.0).abs() < 1e-12);
     for x in [0.1, 0.35, 0.7, 0.95] {
-        assert!(
-            (integrate(pdf, 0.0, x, 1e-14).0 - hammon_exit_cdf(x)).abs() < 1e-12,
-            "Y({x})"
-        );
+        assert!((integrate(pdf, 0.0, x, 1e-14).0 - hammon_exit_cdf(x)).abs() < 1e-12, "Y({x})");
     }
     let mean = integrate(|c| c * pdf(c), 0.0, 1.0, 1e-14).0;
     assert!((mean - 0.6875).abs() < 1e-12);
     for i in 0..=1000 {
         let u = i as f64 / 1000.0;
         let c = hammon_exit_cosine(u);
-        assert!(
-            (0.0..=1.0).contains(&c) && (hammon_exit_cdf(c) - u).abs() < 1e-12,
-            "u = {u}: c = {c}"
-        );
+        assert!((0.0..=1.0).contains(&c) && (hammon_exit_cdf(c) - u).abs() < 1e-12, "u = {u}: c = {c}");
     }
 }

@@ -86,8 +86,7 @@ fn order_one_histograms_match_single_scattering() {
         let sim = simulate(&toml, 2);
         let d = mono(&sim, 0);
         for &h in c.hemispheres {
-            let expected = single_scattering_bins(&sim.cases[0], &d.grid, h, 1e-10)
-                .expect("closed form applies");
+            let expected = single_scattering_bins(&sim.cases[0], &d.grid, h, 1e-10).expect("closed form applies");
             let test = chi_square(&weighted_bins(d, 1, h), &expected, d.photons, 5.0);
             assert!(
                 test.p_value > level,
@@ -104,11 +103,7 @@ fn order_one_histograms_match_single_scattering() {
 #[test]
 fn order_one_albedo_matches_quadrature() {
     // (alpha, theta_i, E1 from THEORY.md §9.4 quadrature)
-    let refs = [
-        (1.0, 0.0, 1.0 - std::f64::consts::LN_2),
-        (1.0, 60.0, 0.450694),
-        (0.5, 0.0, 0.687849),
-    ];
+    let refs = [(1.0, 0.0, 1.0 - std::f64::consts::LN_2), (1.0, 60.0, 0.450694), (0.5, 0.0, 0.687849)];
     for (i, (alpha, theta, e1)) in refs.into_iter().enumerate() {
         let toml = format!(
             "paths = 10_000_000\nseed = {}\n[surface]\nalpha = {alpha}\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 2\n",
@@ -121,10 +116,7 @@ fn order_one_albedo_matches_quadrature() {
             (e - e1) / se
         );
         assert!(se < 1.6e-4, "SE {se}");
-        assert!(
-            (e - e1).abs() < 4.0 * se,
-            "alpha {alpha} theta {theta}: E1 = {e} +- {se}, expected {e1}"
-        );
+        assert!((e - e1).abs() < 4.0 * se, "alpha {alpha} theta {theta}: E1 = {e} +- {se}, expected {e1}");
     }
 }
 
@@ -139,11 +131,6 @@ fn a_wrong_lobe_is_rejected() {
     other.alpha_y = 0.55;
     let d = mono(&sim, 0);
     let expected = single_scattering_bins(&other, &d.grid, Hemisphere::R, 1e-10).unwrap();
-    let test = chi_square(
-        &weighted_bins(d, 1, Hemisphere::R),
-        &expected,
-        d.photons,
-        5.0,
-    );
+    let test = chi_square(&weighted_bins(d, 1, Hemisphere::R), &expected, d.photons, 5.0);
     assert!(test.p_value < 1e-6, "p = {}", test.p_value);
 }

@@ -43,14 +43,8 @@ fn expected(density: impl Fn(DVec3) -> f64) -> Vec<f64> {
     let mut out = Vec::new();
     for ic in 0..COS_BINS {
         for ip in 0..PHI_BINS {
-            let u = (
-                ic as f64 / COS_BINS as f64,
-                (ic + 1) as f64 / COS_BINS as f64,
-            );
-            let p = (
-                ip as f64 * TAU / PHI_BINS as f64,
-                (ip + 1) as f64 * TAU / PHI_BINS as f64,
-            );
+            let u = (ic as f64 / COS_BINS as f64, (ic + 1) as f64 / COS_BINS as f64);
+            let p = (ip as f64 * TAU / PHI_BINS as f64, (ip + 1) as f64 * TAU / PHI_BINS as f64);
             let f = |u: f64, phi: f64| {
                 let s = (1.0 - u * u).max(0.0).sqrt();
                 density(DVec3::new(s * phi.cos(), s * phi.sin(), u))
@@ -59,14 +53,8 @@ fn expected(density: impl Fn(DVec3) -> f64) -> Vec<f64> {
             let mut sum = 0.0;
             for a in 0..4 {
                 for b in 0..4 {
-                    let su = (
-                        u.0 + (u.1 - u.0) * a as f64 / 4.0,
-                        u.0 + (u.1 - u.0) * (a + 1) as f64 / 4.0,
-                    );
-                    let sp = (
-                        p.0 + (p.1 - p.0) * b as f64 / 4.0,
-                        p.0 + (p.1 - p.0) * (b + 1) as f64 / 4.0,
-                    );
+                    let su = (u.0 + (u.1 - u.0) * a as f64 / 4.0, u.0 + (u.1 - u.0) * (a + 1) as f64 / 4.0);
+                    let sp = (p.0 + (p.1 - p.0) * b as f64 / 4.0, p.0 + (p.1 - p.0) * (b + 1) as f64 / 4.0);
                     sum += integrate_2d(f, su, sp, 1e-11).0;
                 }
             }
@@ -82,23 +70,13 @@ fn sampled<N: Ndf>(ndf: &N, normals: Normals, w: DVec3, seed: u64) -> Vec<Weight
     for _ in 0..SAMPLES {
         // A ray travelling along d = -w hits a facet drawn for w.
         let m = normals.sample(ndf, -w, &mut rng);
-        assert!(
-            m.is_finite() && (m.length() - 1.0).abs() < 1e-12 && m.z >= 0.0,
-            "bad normal {m}"
-        );
+        assert!(m.is_finite() && (m.length() - 1.0).abs() < 1e-12 && m.z >= 0.0, "bad normal {m}");
         if normals == Normals::Visible {
             assert!(w.dot(m) > -1e-12, "normal {m} faces away from {w}");
         }
         counts[bin_of(m)] += 1;
     }
-    counts
-        .iter()
-        .map(|&c| c as f64 / SAMPLES as f64)
-        .map(|p| WeightedBin {
-            mean: p,
-            second_moment: p,
-        })
-        .collect()
+    counts.iter().map(|&c| c as f64 / SAMPLES as f64).map(|p| WeightedBin { mean: p, second_moment: p }).collect()
 }
 
 /// (theta_deg, phi_deg) of the viewing directions: above the horizon, and below it on both
@@ -137,11 +115,7 @@ fn check<N: Ndf>(ndf: &N, normals: Normals, w: DVec3, level: f64, seed: u64, lab
         assert!((total - 1.0).abs() < 1e-5, "{label}: ∫ D_w = {total}");
     }
     let test = chi_square(&sampled(ndf, normals, w, seed), &expect, SAMPLES, 5.0);
-    assert!(
-        test.p_value > level,
-        "{label}: visible-normal histogram rejected\n{}",
-        test.worst_cells(12)
-    );
+    assert!(test.p_value > level, "{label}: visible-normal histogram rejected\n{}", test.worst_cells(12));
 }
 
 #[test]
@@ -190,11 +164,6 @@ fn hammon_rejection_differs_from_visible_normals() {
     let ndf = Ggx(Roughness::isotropic(0.5));
     let w = direction(60.0, 0.0);
     let expect = expected(|m| ndf.d(m) * w.dot(m).max(0.0) / ndf.projected_area(w));
-    let test = chi_square(
-        &sampled(&ndf, Normals::HammonRejection, w, 7),
-        &expect,
-        SAMPLES,
-        5.0,
-    );
+    let test = chi_square(&sampled(&ndf, Normals::HammonRejection, w, 7), &expect, SAMPLES, 5.0);
     assert!(test.p_value < 1e-6, "p = {}", test.p_value);
 }

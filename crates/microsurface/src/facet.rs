@@ -11,6 +11,7 @@ use rand::Rng;
 
 use crate::fresnel;
 use crate::random::open01;
+use crate::roots::newton_bisect;
 
 /// Which side of the heightfield a ray is on (§4.3): outside (above) or inside (below, only
 /// for dielectrics).
@@ -53,13 +54,7 @@ pub enum Interaction<const C: usize> {
 pub trait Facet<const C: usize>: Send + Sync {
     /// The interaction of light arriving from `w` (pointing away from the facet) with a facet
     /// of normal `m`, `w·m > 0`, on `side` of the surface.
-    fn interact<R: Rng + ?Sized>(
-        &self,
-        w: DVec3,
-        m: DVec3,
-        side: Side,
-        rng: &mut R,
-    ) -> Interaction<C>;
+    fn interact<R: Rng + ?Sized>(&self, w: DVec3, m: DVec3, side: Side, rng: &mut R) -> Interaction<C>;
 }
 
 /// Mirror reflection of `w` about `m`: `2 (w·m) m - w`.
@@ -98,26 +93,14 @@ pub struct Conductor<const C: usize> {
 }
 
 impl<const C: usize> Facet<C> for Conductor<C> {
-    fn interact<R: Rng + ?Sized>(
-        &self,
-        w: DVec3,
-        m: DVec3,
-        _side: Side,
-        _rng: &mut R,
-    ) -> Interaction<C> {
+    fn interact<R: Rng + ?Sized>(&self, w: DVec3, m: DVec3, _side: Side, _rng: &mut R) -> Interaction<C> {
         let c = w.dot(m);
         let weight = match self.fresnel {
             ConductorFresnel::None => [1.0; C],
             ConductorFresnel::Schlick { f0 } => f0.map(|f0| fresnel::schlick(f0, c)),
-            ConductorFresnel::Exact { eta, k } => {
-                std::array::from_fn(|i| fresnel::conductor(eta[i], k[i], c))
-            }
+            ConductorFresnel::Exact { eta, k } => std::array::from_fn(|i| fresnel::conductor(eta[i], k[i], c)),
         };
-        Interaction::One(Branch {
-            dir: reflect(w, m),
-            weight,
-            crosses: false,
-        })
+        Interaction::One(Branch { dir: reflect(w, m), weight, crosses: false })
     }
 }
 
@@ -129,34 +112,17 @@ pub struct Dielectric {
 }
 
 impl<const C: usize> Facet<C> for Dielectric {
-    fn interact<R: Rng + ?Sized>(
-        &self,
-        w: DVec3,
-        m: DVec3,
-        side: Side,
-        _rng: &mut R,
-    ) -> Interaction<C> {
+    fn interact<R: Rng + ?Sized>(&self, w: DVec3, m: DVec3, side: Side, _rng: &mut R) -> Interaction<C> {
         let eta = match side {
             Side::Outside => self.eta,
             Side::Inside => 1.0 / self.eta,
         };
-        let reflected = Branch {
-            dir: reflect(w, m),
-            weight: [1.0; C],
-            crosses: false,
-        };
+        let reflected = Branch { dir: reflect(w, m), weight: [1.0; C], crosses: false };
         let f = fresnel::dielectric(eta, w.dot(m));
         match refract(w, m, eta) {
             Some(dir) if f < 1.0 => Interaction::Two(
-                Branch {
-                    weight: [f; C],
-                    ..reflected
-                },
-                Branch {
-                    dir,
-                    weight: [1.0 - f; C],
-                    crosses: true,
-                },
+                Branch { weight: [f; C], ..reflected },
+                Branch { dir, weight: [1.0 - f; C], crosses: true },
             ),
             _ => Interaction::One(reflected),
         }
@@ -170,21 +136,11 @@ pub struct Lambertian<const C: usize> {
 }
 
 impl<const C: usize> Facet<C> for Lambertian<C> {
-    fn interact<R: Rng + ?Sized>(
-        &self,
-        _w: DVec3,
-        m: DVec3,
-        _side: Side,
-        rng: &mut R,
-    ) -> Interaction<C> {
+    fn interact<R: Rng + ?Sized>(&self, _w: DVec3, m: DVec3, _side: Side, rng: &mut R) -> Interaction<C> {
         let u = open01(rng);
         let cos_theta = (1.0 - u).sqrt();
         let dir = about_normal(m, cos_theta, 2.0 * PI * open01(rng));
-        Interaction::One(Branch {
-            dir,
-            weight: self.albedo,
-            crosses: false,
-        })
+        Interaction::One(Branch { dir, weight: self.albedo, crosses: false })
     }
 }
 
@@ -197,30 +153,13 @@ pub struct Hammon<const C: usize> {
 }
 
 impl<const C: usize> Facet<C> for Hammon<C> {
-    fn interact<R: Rng + ?Sized>(
-        &self,
-        w: DVec3,
-        m: DVec3,
-        _side: Side,
-        rng: &mut R,
-    ) -> Interaction<C> {
+    fn interact<R: Rng + ?Sized>(&self, w: DVec3, m: DVec3, _side: Side, rng: &mut R) -> Interaction<C> {
         let f = self.f0.map(|f0| fresnel::schlick(f0, w.dot(m)));
-        let specular = Branch {
-            dir: reflect(w, m),
-            weight: f,
-            crosses: false,
-        };
+        let specular = Branch { dir: reflect(w, m), weight: f, crosses: false };
         let cos_theta = hammon_exit_cosine(open01(rng));
         let dir = about_normal(m, cos_theta, 2.0 * PI * open01(rng));
         let weight = std::array::from_fn(|i| (1.0 - f[i]) * self.albedo[i]);
-        Interaction::Two(
-            specular,
-            Branch {
-                dir,
-                weight,
-                crosses: false,
-            },
-        )
+        Interaction::Two(specular, Branch { dir, weight, crosses: false })
     }
 }
 
@@ -244,28 +183,8 @@ pub fn hammon_exit_cdf(c: f64) -> f64 {
 /// double precision.
 pub fn hammon_exit_cosine(u: f64) -> f64 {
     let (u2, u3) = (u * u, u * u * u);
-    let guess = (0.0114813 + 154.4 * u + 13002.4 * u2 + 38295.9 * u3)
-        / (1.0 + 1483.57 * u + 33596.4 * u2 + 16520.2 * u3);
-    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
-    let mut c = guess.clamp(0.0, 1.0);
-    for _ in 0..100 {
-        let f = hammon_exit_cdf(c) - u;
-        if f > 0.0 {
-            hi = c;
-        } else {
-            lo = c;
-        }
-        let slope = 2.1 * c * (1.0 - (1.0 - c).powi(5));
-        let newton = c - f / slope;
-        let next = if newton > lo && newton < hi {
-            newton
-        } else {
-            0.5 * (lo + hi)
-        };
-        if (next - c).abs() <= 1e-15 || hi - lo <= 1e-15 {
-            return next;
-        }
-        c = next;
-    }
-    c
+    let guess =
+        (0.0114813 + 154.4 * u + 13002.4 * u2 + 38295.9 * u3) / (1.0 + 1483.57 * u + 33596.4 * u2 + 16520.2 * u3);
+    let density = |c: f64| 2.1 * c * (1.0 - (1.0 - c).powi(5));
+    newton_bisect(|c| hammon_exit_cdf(c) - u, density, 0.0, 1.0, guess)
 }

@@ -24,11 +24,7 @@ pub enum Flight {
 pub fn fly(tau: f64, up: bool, rate: f64, e: f64) -> Flight {
     let travelled = e / rate;
     if up {
-        if travelled > tau {
-            Flight::Escape
-        } else {
-            Flight::Hit(tau - travelled)
-        }
+        if travelled > tau { Flight::Escape } else { Flight::Hit(tau - travelled) }
     } else {
         Flight::Hit(tau + travelled)
     }
@@ -38,9 +34,5 @@ pub fn fly(tau: f64, up: bool, rate: f64, e: f64) -> Flight {
 /// `-ln(1 - u)` with `u = e^{-tau}`, evaluated without cancellation at either end.
 #[inline]
 pub fn other_side_depth(tau: f64) -> f64 {
-    if tau > std::f64::consts::LN_2 {
-        -(-(-tau).exp()).ln_1p()
-    } else {
-        -(-(-tau).exp_m1()).ln()
-    }
+    if tau > std::f64::consts::LN_2 { -(-(-tau).exp()).ln_1p() } else { -(-(-tau).exp_m1()).ln() }
 }

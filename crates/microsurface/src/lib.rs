@@ -11,7 +11,9 @@
 //! * [`normals`]: how the facet hit by a ray is drawn (visible normals or Hammon's rejection);
 //! * [`fresnel`]: Fresnel reflectances;
 //! * [`facet`]: the micro-BSDF of a single facet (conductor, dielectric, Lambertian, Hammon);
-//! * [`walk`]: the random walk of Heitz et al. 2016 that composes them.
+//! * [`walk`]: the random walk of Heitz et al. 2016 that composes them;
+//! * [`single`]: exact single scattering, the walk's order-1 oracle;
+//! * [`random`], [`roots`]: variates and the root finder behind the inverse-CDF samplers.
 //!
 //! Everything here is pure physics: no I/O, no threads, no binning.
 
@@ -21,6 +23,7 @@ pub mod height;
 pub mod ndf;
 pub mod normals;
 pub mod random;
+pub mod roots;
 pub mod single;
 pub mod smith;
 pub mod walk;

@@ -12,6 +12,7 @@ use rand::Rng;
 use statrs::function::erf::{erf_inv, erfc};
 
 use crate::random::open01;
+use crate::roots::newton_bisect;
 
 const SQRT_PI: f64 = 1.772_453_850_905_516;
 
@@ -99,11 +100,7 @@ impl Ndf for Ggx {
     fn lambda(&self, w: DVec3) -> f64 {
         let t = self.0.tangential2(w);
         let norm = (t + w.z * w.z).sqrt();
-        if w.z > 0.0 {
-            t / (2.0 * w.z * (norm + w.z))
-        } else {
-            (norm - w.z) / (2.0 * w.z)
-        }
+        if w.z > 0.0 { t / (2.0 * w.z * (norm + w.z)) } else { (norm - w.z) / (2.0 * w.z) }
     }
 
     /// `A = (w_z + |A w|) / 2` (§1.5), rearranged below the horizon to avoid cancellation.
@@ -137,11 +134,7 @@ impl Ndf for Ggx {
 
     fn std_slope_cdf(r: f64) -> f64 {
         let r2 = r * r;
-        if r2.is_infinite() {
-            1.0
-        } else {
-            r2 / (1.0 + r2)
-        }
+        if r2.is_infinite() { 1.0 } else { r2 / (1.0 + r2) }
     }
 }
 
@@ -188,17 +181,9 @@ impl Ndf for Beckmann {
             return f64::NAN;
         }
         if w.z == 0.0 {
-            return if w.z.is_sign_positive() {
-                f64::INFINITY
-            } else {
-                f64::NEG_INFINITY
-            };
+            return if w.z.is_sign_positive() { f64::INFINITY } else { f64::NEG_INFINITY };
         }
-        if a > 0.0 {
-            beckmann_lambda_above(a)
-        } else {
-            -1.0 - beckmann_lambda_above(-a)
-        }
+        if a > 0.0 { beckmann_lambda_above(a) } else { -1.0 - beckmann_lambda_above(-a) }
     }
 
     /// `A = (1 + Lambda(w)) w_z` above the horizon and `Lambda(-w) |w_z|` below (§1.5, §10).
@@ -221,11 +206,7 @@ impl Ndf for Beckmann {
         let sin_theta = ws.x.hypot(ws.y);
         let (x, cos_phi, sin_phi) = if sin_theta > 0.0 {
             let mu = ws.z / sin_theta;
-            (
-                visible_slope_beckmann(mu, rng),
-                ws.x / sin_theta,
-                ws.y / sin_theta,
-            )
+            (visible_slope_beckmann(mu, rng), ws.x / sin_theta, ws.y / sin_theta)
         } else if ws.z > 0.0 {
             (erf_inv(2.0 * open01(rng) - 1.0), 1.0, 0.0)
         } else {
@@ -270,31 +251,12 @@ fn visible_slope_beckmann<R: Rng + ?Sized>(mu: f64, rng: &mut R) -> f64 {
     }
     let cdf = |x: f64| 0.5 * SQRT_PI * mu * erfc(-x) + 0.5 * (-x * x).exp();
     let target = open01(rng) * cdf(mu);
-    let (mut lo, mut hi) = (mu.min(0.0) - 1.0, mu);
+    let mut lo = mu.min(0.0) - 1.0;
     while cdf(lo) > target {
         lo = 2.0 * lo - 1.0;
     }
-    let mut x = erf_inv(2.0 * target / cdf(mu) - 1.0).clamp(lo, hi);
-    for _ in 0..100 {
-        let f = cdf(x) - target;
-        if f > 0.0 {
-            hi = x;
-        } else {
-            lo = x;
-        }
-        let slope = (mu - x) * (-x * x).exp();
-        let newton = x - f / slope;
-        let next = if newton > lo && newton < hi {
-            newton
-        } else {
-            0.5 * (lo + hi)
-        };
-        if (next - x).abs() <= 1e-15 * (1.0 + x.abs()) || hi - lo <= 1e-15 * (1.0 + x.abs()) {
-            return next;
-        }
-        x = next;
-    }
-    x
+    let guess = erf_inv(2.0 * target / cdf(mu) - 1.0);
+    newton_bisect(|x| cdf(x) - target, |x| (mu - x) * (-x * x).exp(), lo, mu, guess)
 }
 
 /// The 1-D marginal of the slope in the vertical plane of a direction with projected roughness

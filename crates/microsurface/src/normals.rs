@@ -48,20 +48,8 @@ fn hammon_rejection<N: Ndf, R: Rng + ?Sized>(ndf: &N, d: DVec3, rng: &mut R) -> 
     let roughness = ndf.roughness();
     let t = roughness.stretch(d);
     let t_h = t.x.hypot(t.y);
-    let (cos_b, sin_b) = if t_h > 0.0 {
-        (t.x / t_h, t.y / t_h)
-    } else {
-        (1.0, 0.0)
-    };
-    let x1_min = if t.z > 0.0 {
-        if t_h > 0.0 {
-            N::std_slope_cdf(t.z / t_h)
-        } else {
-            1.0
-        }
-    } else {
-        0.0
-    };
+    let (cos_b, sin_b) = if t_h > 0.0 { (t.x / t_h, t.y / t_h) } else { (1.0, 0.0) };
+    let x1_min = if t.z > 0.0 { if t_h > 0.0 { N::std_slope_cdf(t.z / t_h) } else { 1.0 } } else { 0.0 };
     if x1_min >= 1.0 {
         // Travelling straight up: no facet faces the ray (A(-z) = 0, §10).
         return DVec3::Z;
@@ -73,11 +61,7 @@ fn hammon_rejection<N: Ndf, R: Rng + ?Sized>(ndf: &N, d: DVec3, rng: &mut R) -> 
         let (s, c) = phi.sin_cos();
         let m_local = DVec3::new(c * r, s * r, 1.0);
         if t_h * m_local.x + t.z * m_local.z < 0.0 {
-            let m = DVec3::new(
-                cos_b * m_local.x - sin_b * m_local.y,
-                sin_b * m_local.x + cos_b * m_local.y,
-                1.0,
-            );
+            let m = DVec3::new(cos_b * m_local.x - sin_b * m_local.y, sin_b * m_local.x + cos_b * m_local.y, 1.0);
             return roughness.unstretch_normal(m.normalize());
         }
     }

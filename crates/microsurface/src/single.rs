@@ -32,13 +32,7 @@ pub fn reflection<N: Ndf>(ndf: &N, wi: DVec3, wo: DVec3, fresnel: impl Fn(f64) -
 
 /// Dielectric transmission in its power-conserving form (§5, [W07] Eq. 21 with `G2^T`):
 /// `wi` above, `wo` below, `eta = eta_o / eta_i`; `fresnel` is the reflectance at `wi·h`.
-pub fn transmission<N: Ndf>(
-    ndf: &N,
-    wi: DVec3,
-    wo: DVec3,
-    eta: f64,
-    fresnel: impl Fn(f64) -> f64,
-) -> f64 {
+pub fn transmission<N: Ndf>(ndf: &N, wi: DVec3, wo: DVec3, eta: f64, fresnel: impl Fn(f64) -> f64) -> f64 {
     if wi.z <= 0.0 || wo.z >= 0.0 {
         return 0.0;
     }
@@ -51,6 +45,5 @@ pub fn transmission<N: Ndf>(
         return 0.0;
     }
     let denom = ci + eta * co;
-    ci * -co / wi.z * eta * eta * (1.0 - fresnel(ci)) * ndf.d(h) * g2_transmission(ndf, wi, wo)
-        / (denom * denom)
+    ci * -co / wi.z * eta * eta * (1.0 - fresnel(ci)) * ndf.d(h) * g2_transmission(ndf, wi, wo) / (denom * denom)
 }

@@ -98,19 +98,9 @@ impl<N: Ndf> Microsurface<N> {
         R: Rng + ?Sized,
         O: Observer<C>,
     {
-        let side = if wi.z >= 0.0 {
-            Side::Outside
-        } else {
-            Side::Inside
-        };
+        let side = if wi.z >= 0.0 { Side::Outside } else { Side::Inside };
         stack.clear();
-        stack.push(Ray {
-            tau: 0.0,
-            d: -wi,
-            side,
-            beta: [1.0; C],
-            order: 0,
-        });
+        stack.push(Ray { tau: 0.0, d: -wi, side, beta: [1.0; C], order: 0 });
         while let Some(ray) = stack.pop() {
             self.follow(facet, policy, ray, rng, stack, observer);
         }
@@ -192,17 +182,9 @@ impl<N: Ndf> Microsurface<N> {
 /// The ray that follows `branch`.
 fn continue_with<const C: usize>(ray: &Ray<C>, branch: &Branch<C>) -> Ray<C> {
     Ray {
-        tau: if branch.crosses {
-            other_side_depth(ray.tau)
-        } else {
-            ray.tau
-        },
+        tau: if branch.crosses { other_side_depth(ray.tau) } else { ray.tau },
         d: branch.dir,
-        side: if branch.crosses {
-            ray.side.other()
-        } else {
-            ray.side
-        },
+        side: if branch.crosses { ray.side.other() } else { ray.side },
         beta: std::array::from_fn(|i| ray.beta[i] * branch.weight[i]),
         ..*ray
     }
@@ -211,12 +193,7 @@ fn continue_with<const C: usize>(ray: &Ray<C>, branch: &Branch<C>) -> Ray<C> {
 /// Chooses one of two exclusive branches with probability proportional to the weight each
 /// would carry (summed over channels), and divides its factor by that probability so the
 /// choice is unbiased (§4.6). `None` if neither branch carries weight.
-fn choose<const C: usize>(
-    beta: &[f64; C],
-    a: Branch<C>,
-    b: Branch<C>,
-    u: f64,
-) -> Option<Branch<C>> {
+fn choose<const C: usize>(beta: &[f64; C], a: Branch<C>, b: Branch<C>, u: f64) -> Option<Branch<C>> {
     let carried = |br: &Branch<C>| beta.iter().zip(&br.weight).map(|(x, w)| x * w).sum::<f64>();
     let (wa, wb) = (carried(&a), carried(&b));
     let total = wa + wb;
