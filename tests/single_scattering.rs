@@ -134,3 +134,24 @@ fn a_wrong_lobe_is_rejected() {
     let test = chi_square(&weighted_bins(d, 1, Hemisphere::R), &expected, d.photons, 5.0);
     assert!(test.p_value < 1e-6, "p = {}", test.p_value);
 }
+
+#[test]
+#[ignore = "heavy: 10^9 photons per case, about 10 minutes on 2 cores"]
+fn order_one_albedo_to_four_decimals() {
+    // At 10^9 photons the SE is about 1.5e-5, so agreement to 4 decimals (|diff| < 5e-5) is a
+    // 3-sigma statement; the same quadrature references as above.
+    let refs = [(1.0, 0.0, 1.0 - std::f64::consts::LN_2), (1.0, 60.0, 0.450694), (0.5, 0.0, 0.687849)];
+    for (i, (alpha, theta, e1)) in refs.into_iter().enumerate() {
+        let toml = format!(
+            "paths = 1_000_000_000\nseed = {}\n[surface]\nalpha = {alpha}\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 2\n",
+            900 + i
+        );
+        let sim = simulate(&toml, 2);
+        let (e, se) = albedo(mono(&sim, 0), 1, Hemisphere::R);
+        println!(
+            "alpha {alpha} theta {theta}: E1 = {e:.6} +- {se:.6}, quadrature {e1:.6}, diff {:.2} SE",
+            (e - e1) / se
+        );
+        assert!((e - e1).abs() < 5e-5, "alpha {alpha} theta {theta}: E1 = {e} +- {se}, expected {e1} to 4 decimals");
+    }
+}
