@@ -8,10 +8,11 @@
 use glam::DVec3;
 use microsurface::facet::Side;
 use microsurface::walk::{Loss, Observer};
+use serde::{Deserialize, Serialize};
 
 /// A sum in 64.64 fixed point. Conversion truncates below 2^-64, a relative error far below
 /// any statistical error this tool reports.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Fixed(i128);
 
 const FIXED_ONE: f64 = 18_446_744_073_709_551_616.0; // 2^64
@@ -54,11 +55,31 @@ fn to_fixed(x: f64) -> i128 {
 }
 
 /// Sum, sum of squares (per photon) and number of photons of one quantity, per channel.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Tally<const C: usize> {
+    #[serde(with = "per_channel")]
     pub sum: [Fixed; C],
+    #[serde(with = "per_channel")]
     pub sum_sq: [Fixed; C],
     pub count: u64,
+}
+
+/// Serde for `[Fixed; C]` (serde's own array support does not cover a generic length).
+mod per_channel {
+    use serde::de::Error;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    use super::Fixed;
+
+    pub fn serialize<S: Serializer, const C: usize>(values: &[Fixed; C], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(values)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>, const C: usize>(d: D) -> Result<[Fixed; C], D::Error> {
+        let values = Vec::<Fixed>::deserialize(d)?;
+        let n = values.len();
+        values.try_into().map_err(|_| D::Error::custom(format!("{n} channels where {C} were expected")))
+    }
 }
 
 impl<const C: usize> Default for Tally<C> {
@@ -151,7 +172,7 @@ pub enum Hemisphere {
 }
 
 /// Histograms and albedo tallies of one order slot (all orders, one order, or "K+").
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct OrderTallies<const C: usize> {
     /// Per hemisphere and bin: index `hemisphere * bins + bin`.
     pub bins: Vec<Tally<C>>,
@@ -160,8 +181,9 @@ pub struct OrderTallies<const C: usize> {
 }
 
 impl<const C: usize> OrderTallies<C> {
-    fn new(grid: &Grid) -> Self {
-        Self { bins: vec![Tally::default(); 2 * grid.bins()], albedo: [Tally::default(); 2] }
+    /// Empty tallies for `bins` bins over both hemispheres.
+    fn empty(bins: usize) -> Self {
+        Self { bins: vec![Tally::default(); bins], albedo: [Tally::default(); 2] }
     }
 
     fn merge(&mut self, other: &Self) {
@@ -183,13 +205,10 @@ struct Deposit<const C: usize> {
     weight: [f64; C],
 }
 
-/// The detector of one case.
-#[derive(Clone, Debug)]
-pub struct Detector<const C: usize> {
-    pub grid: Grid,
-    rotation: (f64, f64),
-    incident_side: Side,
-    max_order: Option<u32>,
+/// The raw accumulators of one case: everything a detector measured, and all that a shard
+/// of a run must keep so that merged shards reproduce the unsplit run exactly.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Tallies<const C: usize> {
     /// Slot 0: all orders together; slot k: order k (the last slot is "K+" with a `max_order`).
     pub orders: Vec<OrderTallies<C>>,
     /// Per photon: escaped plus lost weight (absorbed = 1 - this).
@@ -197,6 +216,46 @@ pub struct Detector<const C: usize> {
     /// Per photon: weight lost, per [`Loss`] reason (trapped, invalid, runaway).
     pub lost: [Tally<C>; 3],
     pub photons: u64,
+    /// Facet interactions of all rays of all photons (the walk's work, for throughput figures).
+    pub interactions: u64,
+}
+
+impl<const C: usize> Tallies<C> {
+    fn new(grid: &Grid) -> Self {
+        Self {
+            orders: vec![OrderTallies::empty(2 * grid.bins())],
+            accounted: Tally::default(),
+            lost: [Tally::default(); 3],
+            photons: 0,
+            interactions: 0,
+        }
+    }
+
+    /// Adds the photons of other tallies of the same case and grid: exact integer sums.
+    pub fn merge(&mut self, other: &Self) {
+        while self.orders.len() < other.orders.len() {
+            self.orders.push(OrderTallies::empty(other.orders[0].bins.len()));
+        }
+        for (a, b) in self.orders.iter_mut().zip(&other.orders) {
+            a.merge(b);
+        }
+        self.accounted.merge(&other.accounted);
+        for (a, b) in self.lost.iter_mut().zip(&other.lost) {
+            a.merge(b);
+        }
+        self.photons += other.photons;
+        self.interactions += other.interactions;
+    }
+}
+
+/// The detector of one case: its geometry, its tallies, and the escapes of the photon in flight.
+#[derive(Clone, Debug)]
+pub struct Detector<const C: usize> {
+    pub grid: Grid,
+    rotation: (f64, f64),
+    incident_side: Side,
+    max_order: Option<u32>,
+    pub tallies: Tallies<C>,
     pending: Vec<Deposit<C>>,
     pending_loss: [[f64; C]; 3],
     any_loss: bool,
@@ -228,10 +287,7 @@ impl<const C: usize> Detector<C> {
             rotation,
             incident_side: if wi.z >= 0.0 { Side::Outside } else { Side::Inside },
             max_order,
-            orders: vec![OrderTallies::new(&grid)],
-            accounted: Tally::default(),
-            lost: [Tally::default(); 3],
-            photons: 0,
+            tallies: Tallies::new(&grid),
             pending: Vec::new(),
             pending_loss: [[0.0; C]; 3],
             any_loss: false,
@@ -247,7 +303,7 @@ impl<const C: usize> Detector<C> {
 
     /// The highest order slot with any photon in it.
     pub fn highest_slot(&self) -> usize {
-        self.orders.len() - 1
+        self.tallies.orders.len() - 1
     }
 
     /// Whether the last slot holds every order from `max_order` on.
@@ -255,31 +311,33 @@ impl<const C: usize> Detector<C> {
         self.max_order.is_some_and(|k| slot == k as usize)
     }
 
-    /// Closes the current photon: adds its per-bin, per-order and total contributions.
-    pub fn end_photon(&mut self) {
-        self.photons += 1;
+    /// Closes the current photon, which made `interactions` facet interactions: adds its
+    /// per-bin, per-order and total contributions.
+    pub fn end_photon(&mut self, interactions: u64) {
+        self.tallies.photons += 1;
+        self.tallies.interactions += interactions;
         let mut total = [0.0; C];
         for d in &self.pending {
             accumulate(&mut total, &d.weight);
         }
         if self.any_loss {
-            for (tally, w) in self.lost.iter_mut().zip(&self.pending_loss) {
+            for (tally, w) in self.tallies.lost.iter_mut().zip(&self.pending_loss) {
                 tally.add(w);
                 accumulate(&mut total, w);
             }
             self.pending_loss = [[0.0; C]; 3];
             self.any_loss = false;
         }
-        self.accounted.add(&total);
+        self.tallies.accounted.add(&total);
         let needed = self.pending.iter().map(|d| d.slot).max().unwrap_or(0) + 1;
-        while self.orders.len() < needed {
-            self.orders.push(OrderTallies::new(&self.grid));
+        while self.tallies.orders.len() < needed {
+            self.tallies.orders.push(OrderTallies::empty(2 * self.grid.bins()));
         }
         let bins = self.grid.bins();
         if let [d] = self.pending[..] {
             let i = d.hemisphere as usize * bins + d.bin;
             for slot in [0, d.slot] {
-                let o = &mut self.orders[slot];
+                let o = &mut self.tallies.orders[slot];
                 o.bins[i].add(&d.weight);
                 o.albedo[d.hemisphere as usize].add(&d.weight);
             }
@@ -307,11 +365,11 @@ impl<const C: usize> Detector<C> {
             accumulate(&mut hemi_sum, &w);
             let next = keyed.get(n + 1);
             if next.is_none_or(|&(s, h, j, _)| (s, h, j) != (slot, hemi, i)) {
-                self.orders[slot].bins[i].add(&bin_sum);
+                self.tallies.orders[slot].bins[i].add(&bin_sum);
                 bin_sum = [0.0; C];
             }
             if next.is_none_or(|&(s, h, _, _)| (s, h) != (slot, hemi)) {
-                self.orders[slot].albedo[hemi].add(&hemi_sum);
+                self.tallies.orders[slot].albedo[hemi].add(&hemi_sum);
                 hemi_sum = [0.0; C];
             }
         }
@@ -319,17 +377,7 @@ impl<const C: usize> Detector<C> {
 
     /// Adds another detector's photons of the same case.
     pub fn merge(&mut self, other: &Self) {
-        while self.orders.len() < other.orders.len() {
-            self.orders.push(OrderTallies::new(&self.grid));
-        }
-        for (a, b) in self.orders.iter_mut().zip(&other.orders) {
-            a.merge(b);
-        }
-        self.accounted.merge(&other.accounted);
-        for (a, b) in self.lost.iter_mut().zip(&other.lost) {
-            a.merge(b);
-        }
-        self.photons += other.photons;
+        self.tallies.merge(&other.tallies);
     }
 }
 

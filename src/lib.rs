@@ -5,6 +5,7 @@
 //! by a [`detector::Detector`]; [`output`] writes the tables. [`models`], [`quadrature`] and
 //! [`stats`] hold the analytic oracles and the statistics the measurements are tested with.
 
+pub mod bench;
 pub mod cases;
 pub mod config;
 pub mod detector;
@@ -12,6 +13,7 @@ pub mod models;
 pub mod output;
 pub mod quadrature;
 pub mod run;
+pub mod shard;
 pub mod stats;
 
 use std::path::{Path, PathBuf};
@@ -24,7 +26,7 @@ pub use microsurface;
 
 use crate::cases::Case;
 use crate::config::Config;
-use crate::run::{CaseResult, RunSettings, simulate_case};
+use crate::run::{CaseResult, RunSettings, Shard, simulate_case};
 
 /// The measurements of a whole run, in case order.
 #[derive(Clone, Debug)]
@@ -38,15 +40,25 @@ pub struct Simulation {
 
 /// Simulates every case of `config` on `threads` threads (all cores if `None`).
 pub fn simulate(config: &Config, threads: Option<usize>, show_progress: bool) -> Result<Simulation> {
+    simulate_shard(config, Shard::WHOLE, threads, show_progress)
+}
+
+/// Simulates one shard of the work of `config` (see [`run::Shard`]).
+pub fn simulate_shard(
+    config: &Config,
+    shard: Shard,
+    threads: Option<usize>,
+    show_progress: bool,
+) -> Result<Simulation> {
     let cases = cases::expand(config);
-    let settings = RunSettings::from_config(config);
+    let settings = RunSettings { shard, ..RunSettings::from_config(config) };
     let rgb = config.is_rgb();
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(n) = threads {
         builder = builder.num_threads(n);
     }
     let pool = builder.build().context("cannot start the worker threads")?;
-    let total = settings.paths * cases.len() as u64;
+    let total = settings.shard_paths() * cases.len() as u64;
     let progress = if show_progress { ProgressBar::new(total) } else { ProgressBar::hidden() };
     progress.set_style(
         ProgressStyle::with_template(

@@ -1,7 +1,7 @@
 //! The `smithwalk` command line.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Result;
@@ -9,6 +9,8 @@ use clap::{Parser, Subcommand};
 use smithwalk::Simulation;
 use smithwalk::config::Config;
 use smithwalk::output::{EnergyBalance, prepare_dir};
+use smithwalk::run::Shard;
+use smithwalk::shard::write_shard;
 
 #[derive(Parser)]
 #[command(version, about = "A virtual gonioreflectometer for the Smith microsurface")]
@@ -35,16 +37,63 @@ enum Command {
         /// Output directory (default: out/<config name>).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Walk only share I of N (chunk c of every case goes to share c mod N) and write its
+        /// raw accumulators (shard.bin) instead of the tables; combine with `smithwalk merge`.
+        #[arg(long, value_name = "I/N", value_parser = Shard::parse)]
+        shard: Option<Shard>,
+    },
+    /// Combine the shard.bin files of all shards of a run into the run's tables, identical to
+    /// those of the unsplit run.
+    Merge {
+        /// The shards' output directories.
+        #[arg(required = true)]
+        shards: Vec<PathBuf>,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Measure the walk's throughput on the reference cases (paths/s per core, ns per
+    /// facet interaction, and the 1 -> 2 thread scaling).
+    Bench {
+        /// Photons per case and thread count.
+        #[arg(long, default_value_t = 4_000_000)]
+        paths: u64,
     },
 }
 
-fn run(
-    config_path: PathBuf,
+fn bench(paths: u64) -> Result<()> {
+    use smithwalk::bench::{CASES, measure};
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    println!("{:<36} {:>14} {:>12} {:>10} {:>14}", "case", "paths/s/core", "ns/bounce", "bounces", "scaling 1->2");
+    for (i, (label, _, _)) in CASES.iter().enumerate() {
+        let one = measure(i, paths, 1)?;
+        let scaling = if cores >= 2 {
+            let two = measure(i, paths, 2)?;
+            format!("{:.2}x", two.paths_per_second / one.paths_per_second)
+        } else {
+            "n/a (1 core)".to_string()
+        };
+        println!(
+            "{label:<36} {:>14.3e} {:>12.1} {:>10.3} {scaling:>14}",
+            one.per_core(),
+            one.ns_per_interaction(),
+            one.interactions_per_path
+        );
+    }
+    Ok(())
+}
+
+/// The options of `smithwalk run`.
+struct RunArgs {
+    config: PathBuf,
     paths: Option<u64>,
     seed: Option<u64>,
     threads: Option<usize>,
     out: Option<PathBuf>,
-) -> Result<()> {
+    shard: Option<Shard>,
+}
+
+fn run(RunArgs { config: config_path, paths, seed, threads, out, shard }: RunArgs) -> Result<()> {
     let mut config = Config::load(&config_path)?;
     if let Some(p) = paths {
         config.paths = p;
@@ -60,10 +109,35 @@ fn run(
         PathBuf::from("out").join(config_path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()))
     });
     prepare_dir(&out)?;
+    if let Some(shard) = shard {
+        let sim = smithwalk::simulate_shard(&config, shard, threads, true)?;
+        let written = write_shard(&sim, &config, shard, &out)?;
+        println!(
+            "shard {}/{} of {} cases in {:.2} s on {} threads: wrote {}",
+            shard.index,
+            shard.count,
+            sim.cases.len(),
+            sim.wall_seconds,
+            sim.threads,
+            written.display()
+        );
+        return Ok(());
+    }
     let sim = smithwalk::simulate(&config, threads, true)?;
     let written = smithwalk::write_outputs(&sim, &config, &out)?;
-    if let Err(e) = print_summary(&sim, &config, &written) {
-        // A closed pipe (`| head`) is not an error of the run: the outputs are written.
+    report(&sim, &config, &written)
+}
+
+fn merge(shards: &[PathBuf], out: &Path) -> Result<()> {
+    let (config, sim) = smithwalk::shard::merge(shards)?;
+    prepare_dir(out)?;
+    let written = smithwalk::write_outputs(&sim, &config, out)?;
+    report(&sim, &config, &written)
+}
+
+/// Prints the end summary; a closed pipe (`| head`) is not an error, the outputs are written.
+fn report(sim: &Simulation, config: &Config, written: &[PathBuf]) -> Result<()> {
+    if let Err(e) = print_summary(sim, config, written) {
         if e.kind() != std::io::ErrorKind::BrokenPipe {
             return Err(e.into());
         }
@@ -120,7 +194,11 @@ fn print_summary(sim: &Simulation, config: &Config, written: &[PathBuf]) -> std:
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { config, paths, seed, threads, out } => run(config, paths, seed, threads, out),
+        Command::Run { config, paths, seed, threads, out, shard } => {
+            run(RunArgs { config, paths, seed, threads, out, shard })
+        }
+        Command::Merge { shards, out } => merge(&shards, &out),
+        Command::Bench { paths } => bench(paths),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

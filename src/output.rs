@@ -70,6 +70,8 @@ pub struct EnergyBalance {
     pub folded: Vec<f64>,
     /// Highest order slot with light in it.
     pub highest_order: usize,
+    /// Mean number of facet interactions per photon (all its rays).
+    pub interactions_per_path: f64,
 }
 
 fn per_channel<const C: usize>(f: impl Fn(usize) -> f64) -> Vec<f64> {
@@ -78,26 +80,27 @@ fn per_channel<const C: usize>(f: impl Fn(usize) -> f64) -> Vec<f64> {
 
 impl EnergyBalance {
     fn of<const C: usize>(d: &Detector<C>) -> Self {
-        let n = d.photons;
+        let n = d.tallies.photons;
         let mean = |t: &Tally<C>, c| t.mean_and_stderr(n, c).0;
-        let all = &d.orders[0];
+        let all = &d.tallies.orders[0];
         let last = d.highest_slot();
         Self {
             reflected: per_channel::<C>(|c| mean(&all.albedo[0], c)),
             transmitted: per_channel::<C>(|c| mean(&all.albedo[1], c)),
-            absorbed: per_channel::<C>(|c| 1.0 - mean(&d.accounted, c)),
-            absorbed_stderr: per_channel::<C>(|c| d.accounted.mean_and_stderr(n, c).1),
-            lost_trapped: per_channel::<C>(|c| mean(&d.lost[0], c)),
-            lost_invalid: per_channel::<C>(|c| mean(&d.lost[1], c)),
-            lost_runaway: per_channel::<C>(|c| mean(&d.lost[2], c)),
+            absorbed: per_channel::<C>(|c| 1.0 - mean(&d.tallies.accounted, c)),
+            absorbed_stderr: per_channel::<C>(|c| d.tallies.accounted.mean_and_stderr(n, c).1),
+            lost_trapped: per_channel::<C>(|c| mean(&d.tallies.lost[0], c)),
+            lost_invalid: per_channel::<C>(|c| mean(&d.tallies.lost[1], c)),
+            lost_runaway: per_channel::<C>(|c| mean(&d.tallies.lost[2], c)),
             folded: per_channel::<C>(|c| {
                 if d.is_folded(last) {
-                    mean(&d.orders[last].albedo[0], c) + mean(&d.orders[last].albedo[1], c)
+                    mean(&d.tallies.orders[last].albedo[0], c) + mean(&d.tallies.orders[last].albedo[1], c)
                 } else {
                     0.0
                 }
             }),
             highest_order: last,
+            interactions_per_path: d.tallies.interactions as f64 / n as f64,
         }
     }
 
@@ -120,8 +123,8 @@ fn channel_header(rgb: bool) -> Vec<&'static str> {
 fn lobe_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Detector<C>) -> Result<()> {
     let fields = case_fields(case);
     let grid = d.grid;
-    let n = d.photons;
-    for (slot, tallies) in d.orders.iter().enumerate() {
+    let n = d.tallies.photons;
+    for (slot, tallies) in d.tallies.orders.iter().enumerate() {
         for &hemisphere in hemispheres(case) {
             let sign = hemisphere_sign(case.side, hemisphere);
             for ic in 0..grid.cos_bins {
@@ -154,7 +157,7 @@ fn lobe_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Dete
 
 fn summary_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Detector<C>) -> Result<()> {
     let fields = case_fields(case);
-    let n = d.photons;
+    let n = d.tallies.photons;
     let mut write = |order: usize, what: &str, c: usize, value: f64, se: f64, folded: bool| {
         let mut row = fields.clone();
         row.push(n.to_string());
@@ -166,7 +169,7 @@ fn summary_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &D
         row.extend([value.to_string(), se.to_string(), folded.to_string()]);
         w.write_record(&row)
     };
-    for (slot, tallies) in d.orders.iter().enumerate() {
+    for (slot, tallies) in d.tallies.orders.iter().enumerate() {
         for &hemisphere in hemispheres(case) {
             for c in 0..C {
                 let (albedo, se) = tallies.albedo[hemisphere as usize].mean_and_stderr(n, c);
@@ -175,10 +178,10 @@ fn summary_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &D
         }
     }
     for c in 0..C {
-        let (accounted, se) = d.accounted.mean_and_stderr(n, c);
+        let (accounted, se) = d.tallies.accounted.mean_and_stderr(n, c);
         write(0, "absorbed", c, 1.0 - accounted, se, false)?;
-        let lost: f64 = d.lost.iter().map(|t| t.mean_and_stderr(n, c).0).sum();
-        let lost_se = d.lost.iter().map(|t| t.mean_and_stderr(n, c).1.powi(2)).sum::<f64>().sqrt();
+        let lost: f64 = d.tallies.lost.iter().map(|t| t.mean_and_stderr(n, c).0).sum();
+        let lost_se = d.tallies.lost.iter().map(|t| t.mean_and_stderr(n, c).1.powi(2)).sum::<f64>().sqrt();
         write(0, "lost", c, lost, lost_se, false)?;
     }
     Ok(())

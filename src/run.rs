@@ -11,6 +11,7 @@ use microsurface::normals::Normals;
 use microsurface::smith::Smith;
 use microsurface::walk::{EnergyPolicy, Microsurface};
 use rand_pcg::Pcg64Mcg;
+use serde::{Deserialize, Serialize};
 
 use crate::cases::Case;
 use crate::config::{Config, FresnelKind, MaterialConfig, NdfKind, NormalsKind, SmithKind};
@@ -20,6 +21,29 @@ use crate::detector::{Detector, Grid};
 /// changing it changes which random numbers each photon uses.
 pub const CHUNK: u64 = 1 << 14;
 
+/// A share of a run's work: chunk `c` of every case belongs to shard `c % count`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    pub index: u64,
+    pub count: u64,
+}
+
+impl Shard {
+    /// The whole run.
+    pub const WHOLE: Shard = Shard { index: 0, count: 1 };
+
+    /// Parses `I/N` with `0 <= I < N`.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let bad = || format!("`--shard` = {text:?} is not allowed: expected I/N with 0 <= I < N, e.g. 0/4");
+        let (i, n) = text.split_once('/').ok_or_else(bad)?;
+        let (index, count) = (i.trim().parse::<u64>().map_err(|_| bad())?, n.trim().parse::<u64>().map_err(|_| bad())?);
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+}
+
 /// What every case of a run shares.
 #[derive(Clone, Copy, Debug)]
 pub struct RunSettings {
@@ -28,6 +52,7 @@ pub struct RunSettings {
     pub grid: Grid,
     pub max_order: Option<u32>,
     pub policy: EnergyPolicy,
+    pub shard: Shard,
 }
 
 impl RunSettings {
@@ -38,11 +63,21 @@ impl RunSettings {
             grid: Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins },
             max_order: config.detector.max_order,
             policy: EnergyPolicy { split: config.energy.split, threshold: config.energy.threshold },
+            shard: Shard::WHOLE,
         }
     }
 
     fn chunks(&self) -> u64 {
         self.paths.div_ceil(CHUNK)
+    }
+
+    /// Photons of one case that this shard walks.
+    pub fn shard_paths(&self) -> u64 {
+        (self.shard.index..self.chunks()).step_by(self.shard.count as usize).map(|c| self.chunk_photons(c)).sum()
+    }
+
+    fn chunk_photons(&self, chunk: u64) -> u64 {
+        CHUNK.min(self.paths - chunk * CHUNK)
     }
 }
 
@@ -170,15 +205,15 @@ where
         let mut detector = Detector::<C>::new(settings.grid, wi, settings.max_order);
         let mut stack = Vec::new();
         loop {
-            let chunk = next.fetch_add(1, Ordering::Relaxed);
+            let chunk = settings.shard.index + next.fetch_add(1, Ordering::Relaxed) * settings.shard.count;
             if chunk >= chunks {
                 break detector;
             }
-            let photons = CHUNK.min(settings.paths - chunk * CHUNK);
+            let photons = settings.chunk_photons(chunk);
             let mut rng = chunk_rng(settings.seed, case.index, chunk);
             for _ in 0..photons {
-                surface.trace(facet, &settings.policy, wi, &mut rng, &mut stack, &mut detector);
-                detector.end_photon();
+                let interactions = surface.trace(facet, &settings.policy, wi, &mut rng, &mut stack, &mut detector);
+                detector.end_photon(interactions);
             }
             progress.inc(photons);
         }

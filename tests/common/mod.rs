@@ -23,10 +23,10 @@ pub fn mono(sim: &Simulation, i: usize) -> &Detector<1> {
 
 /// The per-photon moments of every bin of one order slot and hemisphere.
 pub fn weighted_bins(d: &Detector<1>, slot: usize, hemisphere: Hemisphere) -> Vec<WeightedBin> {
-    let n = d.photons as f64;
+    let n = d.tallies.photons as f64;
     let bins = d.grid.bins();
     let empty = OrderTallies { bins: vec![Default::default(); 2 * bins], albedo: Default::default() };
-    let tallies = d.orders.get(slot).unwrap_or(&empty);
+    let tallies = d.tallies.orders.get(slot).unwrap_or(&empty);
     tallies.bins[hemisphere as usize * bins..(hemisphere as usize + 1) * bins]
         .iter()
         .map(|t| WeightedBin { mean: t.sum[0].to_f64() / n, second_moment: t.sum_sq[0].to_f64() / n })
@@ -36,12 +36,15 @@ pub fn weighted_bins(d: &Detector<1>, slot: usize, hemisphere: Hemisphere) -> Ve
 /// Photon counts of every bin of one order slot and hemisphere.
 pub fn bin_counts(d: &Detector<1>, slot: usize, hemisphere: Hemisphere) -> Vec<u64> {
     let bins = d.grid.bins();
-    d.orders.get(slot).map_or(vec![0; bins], |t| {
+    d.tallies.orders.get(slot).map_or(vec![0; bins], |t| {
         t.bins[hemisphere as usize * bins..(hemisphere as usize + 1) * bins].iter().map(|b| b.count).collect()
     })
 }
 
 /// Albedo and standard error of one order slot and hemisphere.
 pub fn albedo(d: &Detector<1>, slot: usize, hemisphere: Hemisphere) -> (f64, f64) {
-    d.orders.get(slot).map_or((0.0, 0.0), |t| t.albedo[hemisphere as usize].mean_and_stderr(d.photons, 0))
+    d.tallies
+        .orders
+        .get(slot)
+        .map_or((0.0, 0.0), |t| t.albedo[hemisphere as usize].mean_and_stderr(d.tallies.photons, 0))
 }

@@ -85,6 +85,7 @@ impl<N: Ndf> Microsurface<N> {
     /// Walks one photon arriving from `wi` (pointing towards the light; `wi_z > 0` from
     /// outside, `wi_z < 0` from inside a dielectric) with unit weight in every channel, and
     /// reports every escape and loss to `observer`. `stack` is scratch space for split branches.
+    /// Returns the number of facet interactions of all its rays.
     pub fn trace<F, R, O, const C: usize>(
         &self,
         facet: &F,
@@ -93,7 +94,8 @@ impl<N: Ndf> Microsurface<N> {
         rng: &mut R,
         stack: &mut Vec<Ray<C>>,
         observer: &mut O,
-    ) where
+    ) -> u64
+    where
         F: Facet<C>,
         R: Rng + ?Sized,
         O: Observer<C>,
@@ -101,12 +103,15 @@ impl<N: Ndf> Microsurface<N> {
         let side = if wi.z >= 0.0 { Side::Outside } else { Side::Inside };
         stack.clear();
         stack.push(Ray { tau: 0.0, d: -wi, side, beta: [1.0; C], order: 0 });
+        let mut interactions = 0;
         while let Some(ray) = stack.pop() {
-            self.follow(facet, policy, ray, rng, stack, observer);
+            interactions += u64::from(self.follow(facet, policy, ray, rng, stack, observer));
         }
+        interactions
     }
 
     /// Follows one ray until it escapes, is absorbed or lost; split branches go onto `stack`.
+    /// Returns the number of facet interactions it made.
     fn follow<F, R, O, const C: usize>(
         &self,
         facet: &F,
@@ -115,11 +120,13 @@ impl<N: Ndf> Microsurface<N> {
         rng: &mut R,
         stack: &mut Vec<Ray<C>>,
         observer: &mut O,
-    ) where
+    ) -> u32
+    where
         F: Facet<C>,
         R: Rng + ?Sized,
         O: Observer<C>,
     {
+        let start = ray.order;
         loop {
             // The flipped frame (§4.3): on the inside, negate the direction.
             let d = match ray.side {
@@ -128,18 +135,24 @@ impl<N: Ndf> Microsurface<N> {
             };
             let rate = self.smith.rate(&self.ndf, d);
             ray.tau = match fly(ray.tau, d.z > 0.0, rate, exp1(rng)) {
-                Flight::Escape => return observer.escape(ray.order, ray.side, ray.d, &ray.beta),
+                Flight::Escape => {
+                    observer.escape(ray.order, ray.side, ray.d, &ray.beta);
+                    break;
+                }
                 Flight::Hit(tau) => tau,
             };
             if ray.tau.is_nan() {
-                return observer.lose(Loss::Invalid, &ray.beta);
+                observer.lose(Loss::Invalid, &ray.beta);
+                break;
             }
             if ray.tau.is_infinite() {
-                return observer.lose(Loss::Trapped, &ray.beta);
+                observer.lose(Loss::Trapped, &ray.beta);
+                break;
             }
             ray.order += 1;
             if ray.order >= RUNAWAY_ORDER {
-                return observer.lose(Loss::Runaway, &ray.beta);
+                observer.lose(Loss::Runaway, &ray.beta);
+                break;
             }
             let m_flipped = self.normals.sample(&self.ndf, d, rng);
             let m = match ray.side {
@@ -155,27 +168,29 @@ impl<N: Ndf> Microsurface<N> {
                     } else {
                         match choose(&ray.beta, a, b, open01(rng)) {
                             Some(chosen) => chosen,
-                            None => return,
+                            None => break,
                         }
                     }
                 }
             };
             ray = continue_with(&ray, &branch);
             if !ray.d.is_finite() || !weight_is_valid(&ray.beta) {
-                return observer.lose(Loss::Invalid, &ray.beta);
+                observer.lose(Loss::Invalid, &ray.beta);
+                break;
             }
             let largest = max_channel(&ray.beta);
             if largest == 0.0 {
-                return;
+                break;
             }
             if largest < policy.threshold {
                 let survive = largest / policy.threshold;
                 if open01(rng) >= survive {
-                    return;
+                    break;
                 }
                 ray.beta = ray.beta.map(|b| b / survive);
             }
         }
+        ray.order - start
     }
 }
 

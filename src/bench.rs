@@ -1,0 +1,62 @@
+//! `smithwalk bench`: throughput of the walk on the reference cases of the throughput issue,
+//! reported as paths per second per core and nanoseconds per facet interaction, plus the
+//! scaling from 1 to 2 threads.
+
+use anyhow::Result;
+
+use crate::config::Config;
+use crate::simulate;
+
+/// The reference cases: (label, `[surface]` and `[material]` TOML, theta_i in degrees).
+pub const CASES: [(&str, &str, f64); 5] = [
+    ("ggx conductor F=1 a=0.5 60deg", "ndf = \"ggx\"\nalpha = 0.5\n[material]\nkind = \"conductor\"", 60.0),
+    ("ggx conductor F=1 a=1 0deg", "ndf = \"ggx\"\nalpha = 1.0\n[material]\nkind = \"conductor\"", 0.0),
+    (
+        "ggx dielectric 1.5 a=0.5 60deg",
+        "ndf = \"ggx\"\nalpha = 0.5\n[material]\nkind = \"dielectric\"\neta = 1.5",
+        60.0,
+    ),
+    ("ggx diffuse a=1 0deg", "ndf = \"ggx\"\nalpha = 1.0\n[material]\nkind = \"diffuse\"", 0.0),
+    ("beckmann conductor F=1 a=0.5 60deg", "ndf = \"beckmann\"\nalpha = 0.5\n[material]\nkind = \"conductor\"", 60.0),
+];
+
+/// The run configuration of a reference case with `paths` photons and the default detector.
+pub fn case_config(case: usize, paths: u64) -> Config {
+    let (_, surface, theta) = CASES[case];
+    let toml = format!("paths = {paths}\nseed = 1\n[surface]\n{surface}\n[incident]\ntheta_deg = {theta}\n");
+    Config::parse(&toml).expect("reference cases are valid")
+}
+
+/// One measurement: throughput on `threads` threads.
+#[derive(Clone, Copy, Debug)]
+pub struct Throughput {
+    pub paths_per_second: f64,
+    pub interactions_per_path: f64,
+    pub threads: usize,
+}
+
+impl Throughput {
+    pub fn per_core(&self) -> f64 {
+        self.paths_per_second / self.threads as f64
+    }
+
+    /// Wall nanoseconds per facet interaction, per core.
+    pub fn ns_per_interaction(&self) -> f64 {
+        1e9 / (self.per_core() * self.interactions_per_path)
+    }
+}
+
+/// Runs a reference case on `threads` threads.
+pub fn measure(case: usize, paths: u64, threads: usize) -> Result<Throughput> {
+    let config = case_config(case, paths);
+    let sim = simulate(&config, Some(threads), false)?;
+    let interactions = match &sim.results[0] {
+        crate::run::CaseResult::Mono(d) => d.tallies.interactions,
+        crate::run::CaseResult::Rgb(d) => d.tallies.interactions,
+    };
+    Ok(Throughput {
+        paths_per_second: paths as f64 / sim.wall_seconds,
+        interactions_per_path: interactions as f64 / paths as f64,
+        threads: sim.threads,
+    })
+}
