@@ -20,8 +20,8 @@ const FORMAT: &str = "smithwalk-shard-1";
 
 #[derive(Serialize, Deserialize)]
 enum CaseTallies {
-    Mono(Tallies<1>),
-    Rgb(Tallies<3>),
+    Mono(Box<Tallies<1>>),
+    Rgb(Box<Tallies<3>>),
 }
 
 impl CaseTallies {
@@ -77,8 +77,8 @@ pub fn write_shard(sim: &Simulation, config: &Config, shard: Shard, dir: &Path) 
             .results
             .iter()
             .map(|r| match r {
-                CaseResult::Mono(d) => CaseTallies::Mono(d.tallies.clone()),
-                CaseResult::Rgb(d) => CaseTallies::Rgb(d.tallies.clone()),
+                CaseResult::Mono(d) => CaseTallies::Mono(Box::new(d.tallies.clone())),
+                CaseResult::Rgb(d) => CaseTallies::Rgb(Box::new(d.tallies.clone())),
             })
             .collect(),
     };

@@ -71,7 +71,7 @@ fn merge_rejects_bad_shard_sets() {
     let config = Config::parse(CONFIG).unwrap();
     let root = tempfile::tempdir().unwrap();
     let dirs = shard_dirs(&config, 3, root.path());
-    let err = |dirs: &[PathBuf]| merge(dirs).err().expect("merge must fail").to_string();
+    let err = |dirs: &[PathBuf]| merge(dirs).expect_err("merge must fail").to_string();
     assert!(err(&dirs[..2]).contains("missing shards: 2/3"));
     assert!(err(&[dirs[0].clone(), dirs[0].clone(), dirs[1].clone()]).contains("given twice"));
     let other = Config { seed: 32, ..config.clone() };

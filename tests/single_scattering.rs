@@ -87,7 +87,7 @@ fn order_one_histograms_match_single_scattering() {
         let d = mono(&sim, 0);
         for &h in c.hemispheres {
             let expected = single_scattering_bins(&sim.cases[0], &d.grid, h, 1e-10).expect("closed form applies");
-            let test = chi_square(&weighted_bins(d, 1, h), &expected, d.photons, 5.0);
+            let test = chi_square(&weighted_bins(d, 1, h), &expected, d.tallies.photons, 5.0);
             assert!(
                 test.p_value > level,
                 "case {i} ({} / {} at {} deg) {h:?}: order-1 histogram rejected\n{}",
@@ -131,7 +131,7 @@ fn a_wrong_lobe_is_rejected() {
     other.alpha_y = 0.55;
     let d = mono(&sim, 0);
     let expected = single_scattering_bins(&other, &d.grid, Hemisphere::R, 1e-10).unwrap();
-    let test = chi_square(&weighted_bins(d, 1, Hemisphere::R), &expected, d.photons, 5.0);
+    let test = chi_square(&weighted_bins(d, 1, Hemisphere::R), &expected, d.tallies.photons, 5.0);
     assert!(test.p_value < 1e-6, "p = {}", test.p_value);
 }
 
