@@ -342,6 +342,30 @@ pub struct Config {
     pub detector: DetectorConfig,
     #[serde(default)]
     pub energy: EnergyConfig,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub precision: Option<PrecisionConfig>,
+}
+
+/// A precision target: a case stops at the first round of chunks after which the relative
+/// standard error of every nonzero albedo of order slots `0..=orders` (both hemispheres,
+/// channel 0) is at most `target_rel_stderr`; `paths` is then the maximum.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PrecisionConfig {
+    pub target_rel_stderr: f64,
+    #[serde(default = "default_precision_orders")]
+    pub orders: usize,
+}
+
+fn default_precision_orders() -> usize {
+    1
+}
+
+impl PrecisionConfig {
+    /// Whether a case's measurement meets the target.
+    pub fn is_met(&self, result: &crate::run::CaseResult) -> bool {
+        result.relative_stderrs(self.orders).iter().all(|&r| r <= self.target_rel_stderr)
+    }
 }
 
 fn default_seed() -> u64 {
@@ -457,6 +481,15 @@ impl Config {
         }
         if d.max_order == Some(0) {
             return Err(invalid("detector.max_order", 0, "an order >= 1, or leave it out to keep every order"));
+        }
+        if let Some(p) = &self.precision {
+            if !(p.target_rel_stderr.is_finite() && p.target_rel_stderr > 0.0) {
+                return Err(invalid(
+                    "precision.target_rel_stderr",
+                    p.target_rel_stderr,
+                    "a relative standard error > 0",
+                ));
+            }
         }
         let e = &self.energy;
         if !(e.threshold.is_finite() && (0.0..=1.0).contains(&e.threshold)) || (e.split && e.threshold == 0.0) {

@@ -7,6 +7,7 @@
 
 pub mod bench;
 pub mod cases;
+pub mod checkpoint;
 pub mod config;
 pub mod detector;
 pub mod models;
@@ -26,7 +27,7 @@ pub use microsurface;
 
 use crate::cases::Case;
 use crate::config::Config;
-use crate::run::{CaseResult, RunSettings, Shard, simulate_case};
+use crate::run::{CaseResult, CaseState, RunSettings, Shard, run_case, with_walker};
 
 /// The measurements of a whole run, in case order.
 #[derive(Clone, Debug)]
@@ -50,16 +51,51 @@ pub fn simulate_shard(
     threads: Option<usize>,
     show_progress: bool,
 ) -> Result<Simulation> {
+    let options = RunOptions { shard, threads, show_progress };
+    simulate_from(config, &options, None, &mut |_, _, _| Ok(()))
+}
+
+/// Called after every round with (finished cases, the current case, cases not started).
+pub type RoundHook<'a> = dyn FnMut(&[CaseState], &CaseState, &[CaseState]) -> Result<()> + 'a;
+
+/// How to run a simulation, beyond its config.
+#[derive(Clone, Copy, Debug)]
+pub struct RunOptions {
+    pub shard: Shard,
+    pub threads: Option<usize>,
+    pub show_progress: bool,
+}
+
+/// Runs a simulation from saved case states (a resumed checkpoint) or from scratch, calling
+/// `after_round(finished cases, current case, cases not started)` after every round of chunks
+/// (for checkpoints). Cases stop early when `config.precision` is met.
+pub fn simulate_from(
+    config: &Config,
+    options: &RunOptions,
+    states: Option<Vec<CaseState>>,
+    after_round: &mut RoundHook<'_>,
+) -> Result<Simulation> {
     let cases = cases::expand(config);
-    let settings = RunSettings { shard, ..RunSettings::from_config(config) };
+    let settings = RunSettings { shard: options.shard, ..RunSettings::from_config(config) };
     let rgb = config.is_rgb();
     let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = threads {
+    if let Some(n) = options.threads {
         builder = builder.num_threads(n);
     }
     let pool = builder.build().context("cannot start the worker threads")?;
+    let mut states = match states {
+        Some(s) => s,
+        None => cases
+            .iter()
+            .map(|case| CaseState {
+                result: with_walker(case, &settings, rgb, |w| w.empty()),
+                rounds_done: 0,
+                finished: false,
+            })
+            .collect(),
+    };
     let total = settings.shard_paths() * cases.len() as u64;
-    let progress = if show_progress { ProgressBar::new(total) } else { ProgressBar::hidden() };
+    let progress = if options.show_progress { ProgressBar::new(total) } else { ProgressBar::hidden() };
     progress.set_style(
         ProgressStyle::with_template(
             "{elapsed_precise} [{bar:40}] {human_pos}/{human_len} paths ({per_sec}, eta {eta})",
@@ -67,12 +103,21 @@ pub fn simulate_shard(
         .expect("static template")
         .progress_chars("=> "),
     );
+    progress.inc(states.iter().map(|s| s.result.photons()).sum());
     let start = Instant::now();
-    let results = cases.iter().map(|case| simulate_case(case, &settings, rgb, &pool, &progress)).collect();
+    for (i, case) in cases.iter().enumerate() {
+        let (done, rest) = states.split_at_mut(i);
+        let (current, later) = rest.split_first_mut().expect("one state per case");
+        let mut round = |state: &CaseState| -> Result<bool> {
+            after_round(done, state, later)?;
+            Ok(!config.precision.as_ref().is_some_and(|p| p.is_met(&state.result)))
+        };
+        with_walker(case, &settings, rgb, |w| run_case(w, &settings, current, &pool, &progress, &mut round))?;
+    }
     progress.finish_and_clear();
     Ok(Simulation {
         cases,
-        results,
+        results: states.into_iter().map(|s| s.result).collect(),
         rgb,
         threads: pool.current_num_threads(),
         wall_seconds: start.elapsed().as_secs_f64(),

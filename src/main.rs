@@ -4,13 +4,16 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::Result;
+use std::time::Duration;
+
+use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
-use smithwalk::Simulation;
+use smithwalk::checkpoint::{self, Checkpointer};
 use smithwalk::config::Config;
 use smithwalk::output::{EnergyBalance, prepare_dir};
 use smithwalk::run::Shard;
 use smithwalk::shard::write_shard;
+use smithwalk::{RunOptions, Simulation};
 
 #[derive(Parser)]
 #[command(version, about = "A virtual gonioreflectometer for the Smith microsurface")]
@@ -41,6 +44,14 @@ enum Command {
         /// raw accumulators (shard.bin) instead of the tables; combine with `smithwalk merge`.
         #[arg(long, value_name = "I/N", value_parser = Shard::parse)]
         shard: Option<Shard>,
+        /// Continue from the checkpoint in the output directory, if there is one; the outputs
+        /// are bit-identical to an uninterrupted run's.
+        #[arg(long)]
+        resume: bool,
+        /// Seconds between checkpoints (written atomically to checkpoint.bin in the output
+        /// directory, removed when the run finishes).
+        #[arg(long, default_value_t = 10.0)]
+        checkpoint_seconds: f64,
     },
     /// Combine the shard.bin files of all shards of a run into the run's tables, identical to
     /// those of the unsplit run.
@@ -91,9 +102,13 @@ struct RunArgs {
     threads: Option<usize>,
     out: Option<PathBuf>,
     shard: Option<Shard>,
+    resume: bool,
+    checkpoint_seconds: f64,
 }
 
-fn run(RunArgs { config: config_path, paths, seed, threads, out, shard }: RunArgs) -> Result<()> {
+fn run(
+    RunArgs { config: config_path, paths, seed, threads, out, shard, resume, checkpoint_seconds }: RunArgs,
+) -> Result<()> {
     let mut config = Config::load(&config_path)?;
     if let Some(p) = paths {
         config.paths = p;
@@ -103,15 +118,32 @@ fn run(RunArgs { config: config_path, paths, seed, threads, out, shard }: RunArg
     }
     config.validate()?;
     if threads == Some(0) {
-        anyhow::bail!("`--threads` = 0 is not allowed: at least 1 thread");
+        bail!("`--threads` = 0 is not allowed: at least 1 thread");
+    }
+    if !(checkpoint_seconds.is_finite() && checkpoint_seconds > 0.0) {
+        bail!("`--checkpoint-seconds` = {checkpoint_seconds} is not allowed: a positive number of seconds");
+    }
+    let shard = shard.unwrap_or(Shard::WHOLE);
+    if shard.count > 1 && config.precision.is_some() {
+        bail!(
+            "`--shard` = {}/{} is not allowed with a `[precision]` target: shards would stop independently",
+            shard.index,
+            shard.count
+        );
     }
     let out = out.unwrap_or_else(|| {
         PathBuf::from("out").join(config_path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()))
     });
     prepare_dir(&out)?;
-    if let Some(shard) = shard {
-        let sim = smithwalk::simulate_shard(&config, shard, threads, true)?;
+    let states = if resume { checkpoint::load(&out, &config, shard)? } else { None };
+    let mut checkpoints = Checkpointer::new(&out, Duration::from_secs_f64(checkpoint_seconds), &config, shard)?;
+    let options = RunOptions { shard, threads, show_progress: true };
+    let sim = smithwalk::simulate_from(&config, &options, states, &mut |done, current, later| {
+        checkpoints.after_round(done, current, later)
+    })?;
+    if shard != Shard::WHOLE {
         let written = write_shard(&sim, &config, shard, &out)?;
+        checkpoints.finish()?;
         println!(
             "shard {}/{} of {} cases in {:.2} s on {} threads: wrote {}",
             shard.index,
@@ -123,8 +155,8 @@ fn run(RunArgs { config: config_path, paths, seed, threads, out, shard }: RunArg
         );
         return Ok(());
     }
-    let sim = smithwalk::simulate(&config, threads, true)?;
     let written = smithwalk::write_outputs(&sim, &config, &out)?;
+    checkpoints.finish()?;
     report(&sim, &config, &written)
 }
 
@@ -194,8 +226,8 @@ fn print_summary(sim: &Simulation, config: &Config, written: &[PathBuf]) -> std:
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { config, paths, seed, threads, out, shard } => {
-            run(RunArgs { config, paths, seed, threads, out, shard })
+        Command::Run { config, paths, seed, threads, out, shard, resume, checkpoint_seconds } => {
+            run(RunArgs { config, paths, seed, threads, out, shard, resume, checkpoint_seconds })
         }
         Command::Merge { shards, out } => merge(&shards, &out),
         Command::Bench { paths } => bench(paths),

@@ -103,43 +103,142 @@ pub enum CaseResult {
     Rgb(Box<Detector<3>>),
 }
 
-/// Simulates one case over `threads` worker threads of `pool`.
-pub fn simulate_case(
-    case: &Case,
-    settings: &RunSettings,
-    rgb: bool,
-    pool: &rayon::ThreadPool,
-    progress: &ProgressBar,
-) -> CaseResult {
-    if rgb {
-        CaseResult::Rgb(Box::new(with_ndf::<3>(case, settings, pool, progress)))
-    } else {
-        CaseResult::Mono(Box::new(with_ndf::<1>(case, settings, pool, progress)))
+impl CaseResult {
+    /// Adds the photons of another result of the same case.
+    pub fn merge(&mut self, other: &CaseResult) {
+        match (self, other) {
+            (CaseResult::Mono(a), CaseResult::Mono(b)) => a.merge(b),
+            (CaseResult::Rgb(a), CaseResult::Rgb(b)) => a.merge(b),
+            _ => unreachable!("results of one case have one channel count"),
+        }
+    }
+
+    pub fn photons(&self) -> u64 {
+        match self {
+            CaseResult::Mono(d) => d.tallies.photons,
+            CaseResult::Rgb(d) => d.tallies.photons,
+        }
+    }
+
+    /// Relative standard errors of the albedos of order slots `0..=slots` in both hemispheres
+    /// (channel 0), leaving out those with no light.
+    pub fn relative_stderrs(&self, slots: usize) -> Vec<f64> {
+        fn of<const C: usize>(d: &Detector<C>, slots: usize) -> Vec<f64> {
+            let n = d.tallies.photons;
+            d.tallies
+                .orders
+                .iter()
+                .take(slots + 1)
+                .flat_map(|o| o.albedo.iter())
+                .map(|t| t.mean_and_stderr(n, 0))
+                .filter(|(mean, _)| *mean > 0.0)
+                .map(|(mean, se)| se / mean)
+                .collect()
+        }
+        match self {
+            CaseResult::Mono(d) => of(d, slots),
+            CaseResult::Rgb(d) => of(d, slots),
+        }
     }
 }
 
-fn with_ndf<const C: usize>(
-    case: &Case,
-    settings: &RunSettings,
-    pool: &rayon::ThreadPool,
-    progress: &ProgressBar,
-) -> Detector<C> {
+/// A detector type that a [`CaseResult`] can hold.
+pub trait DetectorResult: Sized {
+    fn into_result(self) -> CaseResult;
+    fn of_result(result: &mut CaseResult) -> &mut Self;
+}
+
+impl DetectorResult for Detector<1> {
+    fn into_result(self) -> CaseResult {
+        CaseResult::Mono(Box::new(self))
+    }
+    fn of_result(result: &mut CaseResult) -> &mut Self {
+        match result {
+            CaseResult::Mono(d) => d,
+            CaseResult::Rgb(_) => unreachable!("a mono walker fills mono results"),
+        }
+    }
+}
+
+impl DetectorResult for Detector<3> {
+    fn into_result(self) -> CaseResult {
+        CaseResult::Rgb(Box::new(self))
+    }
+    fn of_result(result: &mut CaseResult) -> &mut Self {
+        match result {
+            CaseResult::Rgb(d) => d,
+            CaseResult::Mono(_) => unreachable!("an RGB walker fills RGB results"),
+        }
+    }
+}
+
+/// Walks the photons of one case, chunk by chunk, into detectors.
+pub trait CaseWalker: Sync {
+    /// An empty detector for this case.
+    fn empty(&self) -> CaseResult;
+    /// Walks every photon of `chunk` into `into`.
+    fn walk_chunk(&self, chunk: u64, into: &mut CaseResult);
+}
+
+/// The walker of one case: a microsurface, a facet material, the incident direction.
+struct Walker<'a, N, F> {
+    surface: Microsurface<N>,
+    facet: F,
+    case: &'a Case,
+    settings: &'a RunSettings,
+}
+
+impl<N, F, const C: usize> CaseWalker for (Walker<'_, N, F>, [(); C])
+where
+    N: Ndf,
+    F: Facet<C>,
+    Detector<C>: DetectorResult,
+{
+    fn empty(&self) -> CaseResult {
+        let w = &self.0;
+        Detector::<C>::new(w.settings.grid, w.case.incident_direction(), w.settings.max_order).into_result()
+    }
+
+    fn walk_chunk(&self, chunk: u64, into: &mut CaseResult) {
+        let w = &self.0;
+        let detector = Detector::<C>::of_result(into);
+        let wi = w.case.incident_direction();
+        let mut rng = chunk_rng(w.settings.seed, w.case.index, chunk);
+        let mut stack = Vec::new();
+        for _ in 0..w.settings.chunk_photons(chunk) {
+            let interactions = w.surface.trace(&w.facet, &w.settings.policy, wi, &mut rng, &mut stack, detector);
+            detector.end_photon(interactions);
+        }
+    }
+}
+
+/// Builds the walker of a case and hands it to `f`. The case's height distribution does not
+/// enter: the walk runs in optical depth, where every height law gives the same walk
+/// (THEORY.md §2.1, §2.4).
+pub fn with_walker<T>(case: &Case, settings: &RunSettings, rgb: bool, f: impl FnOnce(&dyn CaseWalker) -> T) -> T {
+    if rgb { with_ndf::<3, T>(case, settings, f) } else { with_ndf::<1, T>(case, settings, f) }
+}
+
+fn with_ndf<const C: usize, T>(case: &Case, settings: &RunSettings, f: impl FnOnce(&dyn CaseWalker) -> T) -> T
+where
+    Detector<C>: DetectorResult,
+{
     let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
     match case.ndf {
-        NdfKind::Ggx => with_surface::<Ggx, C>(Ggx(roughness), case, settings, pool, progress),
-        NdfKind::Beckmann => with_surface::<Beckmann, C>(Beckmann(roughness), case, settings, pool, progress),
+        NdfKind::Ggx => with_material::<Ggx, C, T>(Ggx(roughness), case, settings, f),
+        NdfKind::Beckmann => with_material::<Beckmann, C, T>(Beckmann(roughness), case, settings, f),
     }
 }
 
-/// Builds the microsurface of a case. The case's height distribution does not enter: the walk
-/// runs in optical depth, where every height law gives the same walk (THEORY.md §2.1, §2.4).
-fn with_surface<N: Ndf, const C: usize>(
+fn with_material<N: Ndf, const C: usize, T>(
     ndf: N,
     case: &Case,
     settings: &RunSettings,
-    pool: &rayon::ThreadPool,
-    progress: &ProgressBar,
-) -> Detector<C> {
+    f: impl FnOnce(&dyn CaseWalker) -> T,
+) -> T
+where
+    Detector<C>: DetectorResult,
+{
     let smith = match case.smith {
         SmithKind::Exact => Smith::Exact,
         SmithKind::Symmetric => Smith::Symmetric,
@@ -148,80 +247,95 @@ fn with_surface<N: Ndf, const C: usize>(
         NormalsKind::Vndf => Normals::Visible,
         NormalsKind::HammonRejection => Normals::HammonRejection,
     };
-    with_material(&Microsurface { ndf, smith, normals }, case, settings, pool, progress)
-}
-
-fn with_material<N: Ndf, const C: usize>(
-    surface: &Microsurface<N>,
-    case: &Case,
-    settings: &RunSettings,
-    pool: &rayon::ThreadPool,
-    progress: &ProgressBar,
-) -> Detector<C> {
+    let surface = Microsurface { ndf, smith, normals };
+    let channels = [(); C];
     match &case.material {
         MaterialConfig::Conductor { fresnel, f0, eta, k, .. } => {
             let fresnel = match fresnel {
                 FresnelKind::None => ConductorFresnel::None,
-                FresnelKind::Schlick => ConductorFresnel::Schlick { f0: channels(f0) },
-                FresnelKind::Exact => ConductorFresnel::Exact { eta: channels(eta), k: channels(k) },
+                FresnelKind::Schlick => ConductorFresnel::Schlick { f0: channels_of(f0) },
+                FresnelKind::Exact => ConductorFresnel::Exact { eta: channels_of(eta), k: channels_of(k) },
             };
-            run_chunks(surface, &Conductor { fresnel }, case, settings, pool, progress)
+            f(&(Walker { surface, facet: Conductor { fresnel }, case, settings }, channels))
         }
         MaterialConfig::Dielectric { eta, .. } => {
-            run_chunks(surface, &Dielectric { eta: *eta }, case, settings, pool, progress)
+            f(&(Walker { surface, facet: Dielectric { eta: *eta }, case, settings }, channels))
         }
         MaterialConfig::Diffuse { albedo, .. } => {
-            run_chunks(surface, &Lambertian { albedo: albedo.to_array() }, case, settings, pool, progress)
+            let facet = Lambertian { albedo: albedo.to_array() };
+            f(&(Walker { surface, facet, case, settings }, channels))
         }
         MaterialConfig::Hammon { f0, albedo, .. } => {
             let facet = Hammon { f0: f0.to_array(), albedo: albedo.to_array() };
-            run_chunks(surface, &facet, case, settings, pool, progress)
+            f(&(Walker { surface, facet, case, settings }, channels))
         }
     }
 }
 
-fn channels<const C: usize>(c: &Option<crate::config::Channels>) -> [f64; C] {
+fn channels_of<const C: usize>(c: &Option<crate::config::Channels>) -> [f64; C] {
     c.expect("validated: the Fresnel mode's parameters are present").to_array()
 }
 
-/// Runs every chunk of a case on the pool: each worker takes the next chunk index from a
-/// shared counter and accumulates into its own detector; the detectors are merged at the end.
-fn run_chunks<N, F, const C: usize>(
-    surface: &Microsurface<N>,
-    facet: &F,
-    case: &Case,
+/// Chunks per round: the unit at which runs checkpoint and check precision targets. Rounds
+/// are fixed stretches of a shard's chunk sequence, so where a run stops does not depend on
+/// threads.
+pub const ROUND_CHUNKS: u64 = 8;
+
+/// How far one case has got: its detector and how many rounds of its chunks are in it.
+#[derive(Clone, Debug)]
+pub struct CaseState {
+    pub result: CaseResult,
+    pub rounds_done: u64,
+    pub finished: bool,
+}
+
+impl RunSettings {
+    /// The chunks of this shard in round `round`.
+    fn round_chunks(&self, round: u64) -> Vec<u64> {
+        let first = round * ROUND_CHUNKS;
+        (first..first + ROUND_CHUNKS)
+            .map(|k| self.shard.index + k * self.shard.count)
+            .filter(|&c| c < self.chunks())
+            .collect()
+    }
+
+    /// Rounds of this shard.
+    fn rounds(&self) -> u64 {
+        let mine = self.chunks().saturating_sub(self.shard.index).div_ceil(self.shard.count);
+        mine.div_ceil(ROUND_CHUNKS)
+    }
+}
+
+/// Continues one case from `state` round by round until its chunks are done or `after_round`
+/// returns false (it is called after every round, e.g. to checkpoint or check precision).
+pub fn run_case(
+    walker: &dyn CaseWalker,
     settings: &RunSettings,
+    state: &mut CaseState,
     pool: &rayon::ThreadPool,
     progress: &ProgressBar,
-) -> Detector<C>
-where
-    N: Ndf,
-    F: Facet<C>,
-{
-    let wi = case.incident_direction();
-    let next = AtomicU64::new(0);
-    let chunks = settings.chunks();
-    let partials = pool.broadcast(|_| {
-        let mut detector = Detector::<C>::new(settings.grid, wi, settings.max_order);
-        let mut stack = Vec::new();
-        loop {
-            let chunk = settings.shard.index + next.fetch_add(1, Ordering::Relaxed) * settings.shard.count;
-            if chunk >= chunks {
-                break detector;
+    after_round: &mut dyn FnMut(&CaseState) -> anyhow::Result<bool>,
+) -> anyhow::Result<()> {
+    while !state.finished {
+        let chunks = settings.round_chunks(state.rounds_done);
+        let next = AtomicU64::new(0);
+        let partials = pool.broadcast(|_| {
+            let mut detector = walker.empty();
+            loop {
+                let k = next.fetch_add(1, Ordering::Relaxed) as usize;
+                let Some(&chunk) = chunks.get(k) else { break detector };
+                walker.walk_chunk(chunk, &mut detector);
+                progress.inc(settings.chunk_photons(chunk));
             }
-            let photons = settings.chunk_photons(chunk);
-            let mut rng = chunk_rng(settings.seed, case.index, chunk);
-            for _ in 0..photons {
-                let interactions = surface.trace(facet, &settings.policy, wi, &mut rng, &mut stack, &mut detector);
-                detector.end_photon(interactions);
-            }
-            progress.inc(photons);
+        });
+        for p in &partials {
+            state.result.merge(p);
         }
-    });
-    let mut partials = partials.into_iter();
-    let mut total = partials.next().unwrap_or_else(|| Detector::new(settings.grid, wi, settings.max_order));
-    for p in partials {
-        total.merge(&p);
+        state.rounds_done += 1;
+        state.finished = state.rounds_done >= settings.rounds();
+        if !after_round(state)? {
+            state.finished = true;
+        }
     }
-    total
+    Ok(())
 }

@@ -8,7 +8,7 @@ use anyhow::{Context, Result, bail, ensure};
 use serde::{Deserialize, Serialize};
 
 use crate::Simulation;
-use crate::cases::expand;
+use crate::cases::{Case, expand};
 use crate::config::Config;
 use crate::detector::{Detector, Grid, Tallies};
 use crate::output::write_atomically;
@@ -18,13 +18,40 @@ use crate::run::{CaseResult, Shard};
 pub const SHARD_FILE: &str = "shard.bin";
 const FORMAT: &str = "smithwalk-shard-1";
 
+/// The raw accumulators of one case, as saved in shard and checkpoint files.
 #[derive(Serialize, Deserialize)]
-enum CaseTallies {
+pub(crate) enum CaseTallies {
     Mono(Box<Tallies<1>>),
     Rgb(Box<Tallies<3>>),
 }
 
 impl CaseTallies {
+    pub(crate) fn of(result: &CaseResult) -> Self {
+        match result {
+            CaseResult::Mono(d) => CaseTallies::Mono(Box::new(d.tallies.clone())),
+            CaseResult::Rgb(d) => CaseTallies::Rgb(Box::new(d.tallies.clone())),
+        }
+    }
+
+    /// The result of `case` holding these tallies.
+    pub(crate) fn into_result(self, case: &Case, config: &Config) -> CaseResult {
+        let grid = Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins };
+        let wi = case.incident_direction();
+        let max_order = config.detector.max_order;
+        match self {
+            CaseTallies::Mono(t) => {
+                let mut d = Detector::<1>::new(grid, wi, max_order);
+                d.tallies = *t;
+                CaseResult::Mono(Box::new(d))
+            }
+            CaseTallies::Rgb(t) => {
+                let mut d = Detector::<3>::new(grid, wi, max_order);
+                d.tallies = *t;
+                CaseResult::Rgb(Box::new(d))
+            }
+        }
+    }
+
     fn mono(&self) -> Option<&Tallies<1>> {
         if let CaseTallies::Mono(t) = self { Some(t) } else { None }
     }
@@ -73,14 +100,7 @@ pub fn write_shard(sim: &Simulation, config: &Config, shard: Shard, dir: &Path) 
         shard,
         threads: sim.threads,
         wall_seconds: sim.wall_seconds,
-        tallies: sim
-            .results
-            .iter()
-            .map(|r| match r {
-                CaseResult::Mono(d) => CaseTallies::Mono(Box::new(d.tallies.clone())),
-                CaseResult::Rgb(d) => CaseTallies::Rgb(Box::new(d.tallies.clone())),
-            })
-            .collect(),
+        tallies: sim.results.iter().map(CaseTallies::of).collect(),
     };
     let bytes = postcard::to_stdvec(&file).context("cannot encode the shard")?;
     let written = write_atomically(dir, &[(SHARD_FILE, bytes)])?;
