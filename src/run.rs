@@ -279,7 +279,7 @@ fn channels_of<const C: usize>(c: &Option<crate::config::Channels>) -> [f64; C] 
 /// Chunks per round: the unit at which runs checkpoint and check precision targets. Rounds
 /// are fixed stretches of a shard's chunk sequence, so where a run stops does not depend on
 /// threads.
-pub const ROUND_CHUNKS: u64 = 8;
+pub const ROUND_CHUNKS: u64 = 32;
 
 /// How far one case has got: its detector and how many rounds of its chunks are in it.
 #[derive(Clone, Debug)]
