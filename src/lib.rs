@@ -27,7 +27,7 @@ pub use microsurface;
 
 use crate::cases::Case;
 use crate::config::Config;
-use crate::run::{CaseResult, CaseState, RunSettings, Shard, run_case, with_walker};
+use crate::run::{CaseResult, CaseState, Estimator, RunSettings, Shard, run_case, with_walker};
 
 /// The measurements of a whole run, in case order.
 #[derive(Clone, Debug)]
@@ -51,7 +51,7 @@ pub fn simulate_shard(
     threads: Option<usize>,
     show_progress: bool,
 ) -> Result<Simulation> {
-    let options = RunOptions { shard, threads, show_progress };
+    let options = RunOptions { shard, threads, show_progress, estimator: Estimator::Walk };
     simulate_from(config, &options, None, &mut |_, _, _| Ok(()))
 }
 
@@ -61,6 +61,7 @@ pub type RoundHook<'a> = dyn FnMut(&[CaseState], &CaseState, &[CaseState]) -> Re
 /// How to run a simulation, beyond its config.
 #[derive(Clone, Copy, Debug)]
 pub struct RunOptions {
+    pub estimator: Estimator,
     pub shard: Shard,
     pub threads: Option<usize>,
     pub show_progress: bool,
@@ -76,7 +77,8 @@ pub fn simulate_from(
     after_round: &mut RoundHook<'_>,
 ) -> Result<Simulation> {
     let cases = cases::expand(config);
-    let settings = RunSettings { shard: options.shard, ..RunSettings::from_config(config) };
+    let settings =
+        RunSettings { shard: options.shard, estimator: options.estimator, ..RunSettings::from_config(config) };
     let rgb = config.is_rgb();
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(n) = options.threads {

@@ -11,7 +11,7 @@ use clap::{Parser, Subcommand};
 use smithwalk::checkpoint::{self, Checkpointer};
 use smithwalk::config::Config;
 use smithwalk::output::{EnergyBalance, prepare_dir};
-use smithwalk::run::Shard;
+use smithwalk::run::{Estimator, Shard};
 use smithwalk::shard::write_shard;
 use smithwalk::{RunOptions, Simulation};
 
@@ -137,7 +137,7 @@ fn run(
     prepare_dir(&out)?;
     let states = if resume { checkpoint::load(&out, &config, shard)? } else { None };
     let mut checkpoints = Checkpointer::new(&out, Duration::from_secs_f64(checkpoint_seconds), &config, shard)?;
-    let options = RunOptions { shard, threads, show_progress: true };
+    let options = RunOptions { shard, threads, show_progress: true, estimator: Estimator::Walk };
     let sim = smithwalk::simulate_from(&config, &options, states, &mut |done, current, later| {
         checkpoints.after_round(done, current, later)
     })?;

@@ -10,6 +10,7 @@ use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 use microsurface::normals::Normals;
 use microsurface::smith::Smith;
 use microsurface::walk::{EnergyPolicy, Microsurface};
+use microsurface::wang::Shadowing;
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
 
@@ -44,9 +45,20 @@ impl Shard {
     }
 }
 
+/// What produces the escaping light: the random walk (the measurement) or an analytic model's
+/// path chain evaluated by Monte Carlo into the same detector.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Estimator {
+    /// The random walk on the Smith microsurface (§4).
+    Walk,
+    /// The Wang et al. 2022 chain with the given shadowing model (§6.5).
+    Wang(Shadowing),
+}
+
 /// What every case of a run shares.
 #[derive(Clone, Copy, Debug)]
 pub struct RunSettings {
+    pub estimator: Estimator,
     pub paths: u64,
     pub seed: u64,
     pub grid: Grid,
@@ -58,6 +70,7 @@ pub struct RunSettings {
 impl RunSettings {
     pub fn from_config(config: &Config) -> Self {
         Self {
+            estimator: Estimator::Walk,
             paths: config.paths,
             seed: config.seed,
             grid: Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins },
@@ -205,8 +218,12 @@ where
         let wi = w.case.incident_direction();
         let mut rng = chunk_rng(w.settings.seed, w.case.index, chunk);
         let mut stack = Vec::new();
+        let policy = &w.settings.policy;
         for _ in 0..w.settings.chunk_photons(chunk) {
-            let interactions = w.surface.trace(&w.facet, &w.settings.policy, wi, &mut rng, &mut stack, detector);
+            let interactions = match w.settings.estimator {
+                Estimator::Walk => w.surface.trace(&w.facet, policy, wi, &mut rng, &mut stack, detector),
+                Estimator::Wang(shadowing) => shadowing.trace(&w.surface.ndf, &w.facet, policy, wi, &mut rng, detector),
+            };
             detector.end_photon(interactions);
         }
     }

@@ -13,6 +13,7 @@
 //! * [`facet`]: the micro-BSDF of a single facet (conductor, dielectric, Lambertian, Hammon);
 //! * [`walk`]: the random walk of Heitz et al. 2016 that composes them;
 //! * [`single`]: exact single scattering, the walk's order-1 oracle;
+//! * [`wang`]: the position-free models of Wang et al. 2022 as height-free chains;
 //! * [`random`], [`roots`]: variates and the root finder behind the inverse-CDF samplers.
 //!
 //! Everything here is pure physics: no I/O, no threads, no binning.
@@ -27,5 +28,6 @@ pub mod roots;
 pub mod single;
 pub mod smith;
 pub mod walk;
+pub mod wang;
 
 pub use glam::DVec3;

@@ -208,7 +208,7 @@ fn continue_with<const C: usize>(ray: &Ray<C>, branch: &Branch<C>) -> Ray<C> {
 /// Chooses one of two exclusive branches with probability proportional to the weight each
 /// would carry (summed over channels), and divides its factor by that probability so the
 /// choice is unbiased (§4.6). `None` if neither branch carries weight.
-fn choose<const C: usize>(beta: &[f64; C], a: Branch<C>, b: Branch<C>, u: f64) -> Option<Branch<C>> {
+pub(crate) fn choose<const C: usize>(beta: &[f64; C], a: Branch<C>, b: Branch<C>, u: f64) -> Option<Branch<C>> {
     let carried = |br: &Branch<C>| beta.iter().zip(&br.weight).map(|(x, w)| x * w).sum::<f64>();
     let (wa, wb) = (carried(&a), carried(&b));
     let total = wa + wb;
