@@ -8,20 +8,41 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-/// A field that takes one value or a list of values (a sweep).
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+/// A field that takes one value or a list of values (a sweep). A list is tried first, so
+/// `alpha = [0.5, 1.0]` is two isotropic roughnesses and one anisotropic roughness is written
+/// `[[0.5, 1.0]]`; it is always serialized as a list, so configs round-trip.
+#[derive(Clone, Debug, Deserialize)]
 #[serde(untagged)]
 pub enum OneOrMany<T> {
-    One(T),
     Many(Vec<T>),
+    One(T),
+}
+
+impl<T: Serialize> Serialize for OneOrMany<T> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(self.as_slice())
+    }
+}
+
+impl<T> OneOrMany<T> {
+    pub fn as_slice(&self) -> &[T] {
+        match self {
+            OneOrMany::One(v) => std::slice::from_ref(v),
+            OneOrMany::Many(v) => v,
+        }
+    }
 }
 
 impl<T: Clone> OneOrMany<T> {
     pub fn values(&self) -> Vec<T> {
-        match self {
-            OneOrMany::One(v) => vec![v.clone()],
-            OneOrMany::Many(v) => v.clone(),
-        }
+        self.as_slice().to_vec()
+    }
+}
+
+/// Equal when they hold the same values: `x` and `[x]` are the same sweep.
+impl<T: PartialEq> PartialEq for OneOrMany<T> {
+    fn eq(&self, other: &Self) -> bool {
+        self.as_slice() == other.as_slice()
     }
 }
 
@@ -344,6 +365,19 @@ pub struct Config {
     pub energy: EnergyConfig,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub precision: Option<PrecisionConfig>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compare: Option<CompareConfig>,
+}
+
+/// Models to compare the run with when it finishes (`smithwalk compare` on its output).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CompareConfig {
+    /// Model names: `single`, `wang-correlated`, `wang-uncorrelated`.
+    pub models: Vec<String>,
+    /// Photons per case for the Monte Carlo models (default: the run's `paths`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub paths: Option<u64>,
 }
 
 /// A precision target: a case stops at the first round of chunks after which the relative
@@ -489,6 +523,15 @@ impl Config {
                     p.target_rel_stderr,
                     "a relative standard error > 0",
                 ));
+            }
+        }
+        if let Some(c) = &self.compare {
+            for m in &c.models {
+                crate::compare::Model::parse(m)
+                    .map_err(|allowed| invalid("compare.models", format!("{m:?}"), allowed))?;
+            }
+            if c.paths.is_some_and(|p| p < 2) {
+                return Err(invalid("compare.paths", c.paths.unwrap_or(0), "at least 2 photons per case"));
             }
         }
         let e = &self.energy;

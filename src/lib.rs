@@ -8,6 +8,7 @@
 pub mod bench;
 pub mod cases;
 pub mod checkpoint;
+pub mod compare;
 pub mod config;
 pub mod detector;
 pub mod models;

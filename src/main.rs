@@ -9,6 +9,7 @@ use std::time::Duration;
 use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
 use smithwalk::checkpoint::{self, Checkpointer};
+use smithwalk::compare::Model;
 use smithwalk::config::Config;
 use smithwalk::output::{EnergyBalance, prepare_dir};
 use smithwalk::run::{Estimator, Shard};
@@ -62,6 +63,21 @@ enum Command {
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
+    },
+    /// Compare a run's lobes with analytic models in the same bins; writes models.csv and
+    /// compare.csv into the run directory and prints the worst lobes per model.
+    Compare {
+        /// The run's output directory (with run.json, lobes.csv and summary.csv).
+        run_dir: PathBuf,
+        /// Comma-separated models: single, wang-correlated, wang-uncorrelated.
+        #[arg(long, value_delimiter = ',', value_parser = Model::parse, default_value = "single,wang-correlated,wang-uncorrelated")]
+        models: Vec<Model>,
+        /// Photons per case for the Monte Carlo models (default: the run's).
+        #[arg(long)]
+        paths: Option<u64>,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
     },
     /// Measure the walk's throughput on the reference cases (paths/s per core, ns per
     /// facet interaction, and the 1 -> 2 thread scaling).
@@ -157,7 +173,13 @@ fn run(
     }
     let written = smithwalk::write_outputs(&sim, &config, &out)?;
     checkpoints.finish()?;
-    report(&sim, &config, &written)
+    report(&sim, &config, &written)?;
+    if let Some(c) = &config.compare {
+        let models =
+            c.models.iter().map(|m| Model::parse(m).map_err(anyhow::Error::msg)).collect::<Result<Vec<_>>>()?;
+        print!("{}", smithwalk::compare::compare(&out, &models, c.paths, threads)?);
+    }
+    Ok(())
 }
 
 fn merge(shards: &[PathBuf], out: &Path) -> Result<()> {
@@ -230,6 +252,9 @@ fn main() -> ExitCode {
             run(RunArgs { config, paths, seed, threads, out, shard, resume, checkpoint_seconds })
         }
         Command::Merge { shards, out } => merge(&shards, &out),
+        Command::Compare { run_dir, models, paths, threads } => {
+            smithwalk::compare::compare(&run_dir, &models, paths, threads).map(|report| print!("{report}"))
+        }
         Command::Bench { paths } => bench(paths),
     };
     match result {

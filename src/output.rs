@@ -24,10 +24,10 @@ fn name<T: Serialize>(value: &T) -> String {
 }
 
 /// The leading columns that identify a case.
-const CASE_COLUMNS: [&str; 11] =
+pub(crate) const CASE_COLUMNS: [&str; 11] =
     ["case", "ndf", "alpha_x", "alpha_y", "height", "smith", "normals", "material", "theta_i_deg", "phi_i_deg", "side"];
 
-fn case_fields(case: &Case) -> Vec<String> {
+pub(crate) fn case_fields(case: &Case) -> Vec<String> {
     vec![
         case.index.to_string(),
         name(&case.ndf),
@@ -45,14 +45,14 @@ fn case_fields(case: &Case) -> Vec<String> {
 
 /// Sign of cos(theta) of the directions in a hemisphere: reflection goes back to the light's
 /// side, transmission to the other one.
-fn hemisphere_sign(side: IncidentSide, hemisphere: Hemisphere) -> f64 {
+pub(crate) fn hemisphere_sign(side: IncidentSide, hemisphere: Hemisphere) -> f64 {
     match (side, hemisphere) {
         (IncidentSide::Outside, Hemisphere::R) | (IncidentSide::Inside, Hemisphere::T) => 1.0,
         _ => -1.0,
     }
 }
 
-fn hemispheres(case: &Case) -> &'static [Hemisphere] {
+pub(crate) fn hemispheres(case: &Case) -> &'static [Hemisphere] {
     if case.material.transmits() { &[Hemisphere::R, Hemisphere::T] } else { &[Hemisphere::R] }
 }
 

@@ -46,7 +46,9 @@ fn panel(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
 }
 
 /// `∫_a^b f` by adaptive bisection until each panel's error estimate is below its share of
-/// `abs_tol` (or a depth of 50 halvings). Returns the integral and the summed error estimate.
+/// `abs_tol` (or a depth of 50 halvings). The interval starts as four panels, so that a
+/// narrow feature is not missed by a single panel's 15 nodes. Returns the integral and the
+/// summed error estimate.
 pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, abs_tol: f64) -> (f64, f64) {
     fn recurse(f: &impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, whole: (f64, f64), depth: u32) -> (f64, f64) {
         let (value, err) = whole;
@@ -61,7 +63,13 @@ pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, abs_tol: f64) -> (f64, 
     if a == b {
         return (0.0, 0.0);
     }
-    recurse(&f, a, b, abs_tol, panel(&f, a, b), 0)
+    const START: usize = 4;
+    let width = (b - a) / START as f64;
+    (0..START).fold((0.0, 0.0), |(value, err), i| {
+        let (lo, hi) = (a + i as f64 * width, if i + 1 == START { b } else { a + (i + 1) as f64 * width });
+        let part = recurse(&f, lo, hi, abs_tol / START as f64, panel(&f, lo, hi), 0);
+        (value + part.0, err + part.1)
+    })
 }
 
 /// `∫_{x0}^{x1} ∫_{y0}^{y1} f(x, y) dy dx` by nested adaptive quadrature; the inner integrals

@@ -39,7 +39,7 @@ pub struct ChiSquare {
 }
 
 impl ChiSquare {
-    fn from_cells(cells: Vec<Cell>) -> Self {
+    pub(crate) fn from_cells(cells: Vec<Cell>) -> Self {
         let statistic: f64 = cells.iter().map(|c| c.z * c.z).sum();
         let dof = cells.len();
         let p_value = if dof == 0 { 1.0 } else { ChiSquared::new(dof as f64).map_or(f64::NAN, |d| d.sf(statistic)) };

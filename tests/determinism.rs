@@ -152,3 +152,21 @@ fn a_good_run_writes_all_three_files() {
     assert_eq!(json["seed"], 3);
     assert_eq!(json["paths"], 1000);
 }
+
+#[test]
+fn sweeps_parse_unambiguously_and_round_trip() {
+    use smithwalk::config::{Alpha, OneOrMany};
+    let parse = |alpha: &str| {
+        let text = GOOD.replace("alpha = 0.5", &format!("alpha = {alpha}"));
+        let config = Config::parse(&text).unwrap();
+        // The resolved config written to run.json and shard files parses back to itself.
+        let again = Config::parse(&toml::to_string(&config).unwrap()).unwrap();
+        assert_eq!(again, config, "{alpha}");
+        config.surface.alpha.values()
+    };
+    assert_eq!(parse("[0.5, 1.0]"), vec![Alpha::Isotropic(0.5), Alpha::Isotropic(1.0)]);
+    assert_eq!(parse("[[0.5, 1.0]]"), vec![Alpha::Anisotropic([0.5, 1.0])]);
+    assert_eq!(parse("0.25"), vec![Alpha::Isotropic(0.25)]);
+    assert_eq!(parse("[0.1, [1.0, 0.1]]"), vec![Alpha::Isotropic(0.1), Alpha::Anisotropic([1.0, 0.1])]);
+    assert!(matches!(Config::parse(GOOD).unwrap().surface.alpha, OneOrMany::One(_)));
+}

@@ -1,0 +1,473 @@
+//! `smithwalk compare`: a run's measured lobes against analytic models in the same bins, per
+//! case, order and hemisphere (THEORY.md §4.7, §9.5).
+//!
+//! Models: `single` (exact single scattering by adaptive quadrature, order 1, conductor and
+//! dielectric facets with the true Smith Lambda and visible normals), `wang-correlated` and
+//! `wang-uncorrelated` (the Wang et al. 2022 chains, Monte Carlo into the same detector with
+//! their own standard errors).
+
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use microsurface::wang::Shadowing;
+
+use crate::config::Config;
+use crate::detector::{Grid, Hemisphere};
+use crate::models::single_scattering_bins;
+use crate::output::{case_fields, write_atomically};
+use crate::run::{Estimator, Shard};
+use crate::stats::{Cell, ChiSquare};
+use crate::{RunOptions, Simulation};
+
+/// The analytic models `compare` knows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Model {
+    Single,
+    WangCorrelated,
+    WangUncorrelated,
+}
+
+impl Model {
+    pub const ALL: [Model; 3] = [Model::Single, Model::WangCorrelated, Model::WangUncorrelated];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Model::Single => "single",
+            Model::WangCorrelated => "wang-correlated",
+            Model::WangUncorrelated => "wang-uncorrelated",
+        }
+    }
+
+    pub fn parse(text: &str) -> Result<Self, String> {
+        Model::ALL.into_iter().find(|m| m.name() == text).ok_or_else(|| {
+            let names: Vec<&str> = Model::ALL.iter().map(|m| m.name()).collect();
+            format!("{text:?} is not a model; allowed: {}", names.join(", "))
+        })
+    }
+}
+
+/// A bin's value and standard error.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Value {
+    energy: f64,
+    stderr: f64,
+}
+
+/// Key of one bin row: case, order, hemisphere, channel, cos_lo, phi_lo (as written).
+type BinKey = (String, String, String, String, String, String);
+/// Key of one lobe: case, order, hemisphere, channel.
+type LobeKey = (String, String, String, String);
+
+/// The measured bins of a run directory's `lobes.csv`, with the photon count per bin.
+fn read_lobes(path: &Path) -> Result<HashMap<BinKey, (Value, u64)>> {
+    let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let headers = reader.headers()?.clone();
+    let col = |name: &str| {
+        headers.iter().position(|h| h == name).with_context(|| format!("{}: no column {name}", path.display()))
+    };
+    let (case, order, hemi, cos_lo, phi_lo, energy, se, count) = (
+        col("case")?,
+        col("order")?,
+        col("hemisphere")?,
+        col("cos_lo")?,
+        col("phi_lo_deg")?,
+        col("energy")?,
+        col("energy_stderr")?,
+        col("count")?,
+    );
+    let channel = headers.iter().position(|h| h == "channel");
+    let mut out = HashMap::new();
+    for record in reader.records() {
+        let r = record?;
+        let key = (
+            r[case].to_string(),
+            r[order].to_string(),
+            r[hemi].to_string(),
+            channel.map_or(String::new(), |c| r[c].to_string()),
+            r[cos_lo].to_string(),
+            r[phi_lo].to_string(),
+        );
+        let value = Value { energy: r[energy].parse()?, stderr: r[se].parse()? };
+        out.insert(key, (value, r[count].parse()?));
+    }
+    Ok(out)
+}
+
+/// One model's prediction of one bin.
+struct Prediction {
+    key: BinKey,
+    fields: Vec<String>,
+    value: Value,
+    solid_angle: f64,
+    bounds: [f64; 4],
+}
+
+/// The model's predictions for every bin of every case it applies to.
+fn predict(
+    model: Model,
+    config: &Config,
+    sim_photons: u64,
+    seed: u64,
+    threads: Option<usize>,
+) -> Result<Vec<Prediction>> {
+    let grid = Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins };
+    let cases = crate::cases::expand(config);
+    let mut out = Vec::new();
+    let rows = |case: &crate::cases::Case,
+                order: usize,
+                hemisphere: Hemisphere,
+                channel: &str,
+                values: &mut dyn FnMut(usize) -> Value,
+                out: &mut Vec<Prediction>| {
+        let sign = crate::output::hemisphere_sign(case.side, hemisphere);
+        for ic in 0..grid.cos_bins {
+            let (lo, hi) = grid.cos_edges(ic);
+            let (cos_lo, cos_hi) = if sign > 0.0 { (lo, hi) } else { (-hi, -lo) };
+            for ip in 0..grid.phi_bins {
+                let (phi_lo, phi_hi) = grid.phi_edges_deg(ip);
+                let key = (
+                    case.index.to_string(),
+                    order.to_string(),
+                    format!("{hemisphere:?}"),
+                    channel.to_string(),
+                    cos_lo.to_string(),
+                    phi_lo.to_string(),
+                );
+                out.push(Prediction {
+                    key,
+                    fields: case_fields(case),
+                    value: values(ic * grid.phi_bins + ip),
+                    solid_angle: grid.projected_solid_angle(ic),
+                    bounds: [cos_lo, cos_hi, phi_lo, phi_hi],
+                });
+            }
+        }
+    };
+    match model {
+        Model::Single => {
+            let channel = if config.is_rgb() { "r" } else { "" };
+            for case in &cases {
+                for &h in crate::output::hemispheres(case) {
+                    // Quadrature error far below the statistical error of the measurement.
+                    let tol = 1e-3 / (sim_photons as f64 * grid.bins() as f64);
+                    let Some(bins) = single_scattering_bins(case, &grid, h, tol) else { continue };
+                    rows(case, 1, h, channel, &mut |i| Value { energy: bins[i], stderr: 0.0 }, &mut out);
+                }
+            }
+        }
+        Model::WangCorrelated | Model::WangUncorrelated => {
+            let shadowing =
+                if model == Model::WangCorrelated { Shadowing::Correlated } else { Shadowing::Uncorrelated };
+            let model_config = Config { seed, ..config.clone() };
+            let options =
+                RunOptions { estimator: Estimator::Wang(shadowing), shard: Shard::WHOLE, threads, show_progress: true };
+            let sim = crate::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))?;
+            for_each_lobe(&sim, &mut |case, order, hemisphere, channel, value| {
+                rows(case, order, hemisphere, channel, value, &mut out)
+            });
+        }
+    }
+    Ok(out)
+}
+
+type LobeVisitor<'a> = dyn FnMut(&crate::cases::Case, usize, Hemisphere, &str, &mut dyn FnMut(usize) -> Value) + 'a;
+
+/// Calls `f` for every lobe (case, order, hemisphere, channel) of a simulation with a function
+/// giving each bin's value.
+fn for_each_lobe(sim: &Simulation, f: &mut LobeVisitor<'_>) {
+    fn visit<const C: usize>(case: &crate::cases::Case, d: &crate::detector::Detector<C>, f: &mut LobeVisitor<'_>) {
+        let bins = d.grid.bins();
+        let n = d.tallies.photons;
+        for (slot, tallies) in d.tallies.orders.iter().enumerate() {
+            for &h in crate::output::hemispheres(case) {
+                for c in 0..C {
+                    let channel = if C > 1 { ["r", "g", "b"][c] } else { "" };
+                    let mut value = |i: usize| {
+                        let (energy, stderr) = tallies.bins[h as usize * bins + i].mean_and_stderr(n, c);
+                        Value { energy, stderr }
+                    };
+                    f(case, slot, h, channel, &mut value);
+                }
+            }
+        }
+    }
+    for (case, result) in sim.cases.iter().zip(&sim.results) {
+        match result {
+            crate::run::CaseResult::Mono(d) => visit(case, d, f),
+            crate::run::CaseResult::Rgb(d) => visit(case, d, f),
+        }
+    }
+}
+
+/// The agreement of one lobe with one model.
+struct LobeComparison {
+    key: LobeKey,
+    fields: Vec<String>,
+    model: Model,
+    test: ChiSquare,
+    rel_l1: f64,
+    rel_l2: f64,
+    albedo_measured: Value,
+    albedo_model: Value,
+}
+
+impl LobeComparison {
+    fn albedo_diff_se(&self) -> f64 {
+        let (a, b) = (self.albedo_measured, self.albedo_model);
+        (a.energy - b.energy) / (a.stderr * a.stderr + b.stderr * b.stderr).sqrt()
+    }
+}
+
+/// A Monte Carlo bin as per-photon moments: mean `e` and second moment `q = Q/N`, recovered
+/// from the written energy and standard error (`se^2 = (q - e^2) / (N - 1)`).
+#[derive(Clone, Copy, Default)]
+struct Moments {
+    mean: f64,
+    second: f64,
+}
+
+impl Moments {
+    fn of(v: Value, photons: u64) -> Self {
+        let n = photons as f64;
+        Self { mean: v.energy, second: v.stderr * v.stderr * (n - 1.0) + v.energy * v.energy }
+    }
+
+    fn add(&mut self, other: Moments) {
+        self.mean += other.mean;
+        self.second += other.second;
+    }
+
+    /// Variance of the mean over `photons` photons if the true mean were `mu`: `(mu r - mu^2) / N`
+    /// with `r = q / e` the bin's mean weight (1 for unit weights; 1 assumed for empty bins).
+    fn variance_at(&self, mu: f64, photons: u64) -> f64 {
+        if photons == 0 {
+            return 0.0;
+        }
+        let r = if self.mean > 0.0 { self.second / self.mean } else { 1.0 };
+        ((mu * r - mu * mu) / photons as f64).max(0.0)
+    }
+}
+
+/// The z value of measured moments `m` (over `n_m` photons) against a model's `p` (over `n_p`
+/// photons, 0 for an exact model). Variances are evaluated at the common mean under the null
+/// hypothesis (the model's value, or the photon-weighted mean of two Monte Carlo estimates),
+/// not at the observed values, which would inflate the statistic in sparse bins.
+fn z_value(m: Moments, n_m: u64, p: Moments, n_p: u64) -> Option<f64> {
+    let mu = if n_p == 0 { p.mean } else { (m.mean * n_m as f64 + p.mean * n_p as f64) / (n_m + n_p) as f64 };
+    let var = m.variance_at(mu, n_m) + p.variance_at(mu, n_p);
+    (var > 0.0).then(|| (m.mean - p.mean) / var.sqrt())
+}
+
+/// Compares one lobe bin by bin with [`z_value`]; bins in which fewer than 5 photons are
+/// expected (from the larger of the two energies) are pooled into one cell.
+fn compare_lobe(
+    measured: &HashMap<BinKey, (Value, u64)>,
+    predictions: &[&Prediction],
+    photons: u64,
+    model_photons: u64,
+) -> (ChiSquare, f64, f64, Value) {
+    let mut cells = Vec::new();
+    let (mut pool_m, mut pool_p, mut pool_bins) = (Moments::default(), Moments::default(), Vec::new());
+    let (mut l1, mut l2, mut norm1, mut norm2) = (0.0, 0.0, 0.0, 0.0);
+    let (mut albedo, mut albedo_var) = (0.0, 0.0);
+    for (i, p) in predictions.iter().enumerate() {
+        let m = measured.get(&p.key).map_or(Value::default(), |(v, _)| *v);
+        let (o, e) = (m.energy, p.value.energy);
+        l1 += (o - e).abs();
+        l2 += (o - e) * (o - e);
+        norm1 += e.abs();
+        norm2 += e * e;
+        albedo += e;
+        albedo_var += p.value.stderr * p.value.stderr;
+        let (mm, pm) = (Moments::of(m, photons), Moments::of(p.value, model_photons));
+        match z_value(mm, photons, pm, model_photons) {
+            Some(z) if photons as f64 * o.max(e) >= 5.0 => {
+                cells.push(Cell { bins: vec![i], observed: o, expected: e, z });
+            }
+            _ => {
+                pool_m.add(mm);
+                pool_p.add(pm);
+                pool_bins.push(i);
+            }
+        }
+    }
+    if photons as f64 * pool_m.mean.max(pool_p.mean) >= 5.0 {
+        if let Some(z) = z_value(pool_m, photons, pool_p, model_photons) {
+            cells.push(Cell { bins: pool_bins, observed: pool_m.mean, expected: pool_p.mean, z });
+        }
+    }
+    let rel_l1 = if norm1 > 0.0 { l1 / norm1 } else { 0.0 };
+    let rel_l2 = if norm2 > 0.0 { (l2 / norm2).sqrt() } else { 0.0 };
+    (ChiSquare::from_cells(cells), rel_l1, rel_l2, Value { energy: albedo, stderr: albedo_var.sqrt() })
+}
+
+/// The measured albedos of a run directory's `summary.csv`, per lobe.
+fn read_summary(path: &Path) -> Result<HashMap<LobeKey, Value>> {
+    let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let headers = reader.headers()?.clone();
+    let col = |name: &str| {
+        headers.iter().position(|h| h == name).with_context(|| format!("{}: no column {name}", path.display()))
+    };
+    let (case, order, hemi, albedo, se) =
+        (col("case")?, col("order")?, col("hemisphere")?, col("albedo")?, col("albedo_stderr")?);
+    let channel = headers.iter().position(|h| h == "channel");
+    let mut out = HashMap::new();
+    for record in reader.records() {
+        let r = record?;
+        let key = (
+            r[case].to_string(),
+            r[order].to_string(),
+            r[hemi].to_string(),
+            channel.map_or(String::new(), |c| r[c].to_string()),
+        );
+        out.insert(key, Value { energy: r[albedo].parse()?, stderr: r[se].parse()? });
+    }
+    Ok(out)
+}
+
+/// Runs the comparison of `run_dir` with `models` and writes `models.csv` and `compare.csv`
+/// into it; returns the human-readable report.
+pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Option<usize>) -> Result<String> {
+    let run_json = run_dir.join("run.json");
+    let text = std::fs::read_to_string(&run_json).with_context(|| format!("cannot read {}", run_json.display()))?;
+    let json: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", run_json.display()))?;
+    let Some(config_json) = json.get("config") else { bail!("{}: no `config`", run_json.display()) };
+    let mut config: Config = serde_json::from_value(config_json.clone()).context("the run's config")?;
+    config.validate()?;
+    let measured_photons = config.paths;
+    let measured = read_lobes(&run_dir.join("lobes.csv"))?;
+    let summary = read_summary(&run_dir.join("summary.csv"))?;
+    if let Some(p) = paths {
+        config.paths = p;
+    }
+    config.precision = None;
+    config.compare = None;
+    let rgb = config.is_rgb();
+    let mut model_rows = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<&str> = crate::output::CASE_COLUMNS.to_vec();
+    header.extend(["model", "order", "hemisphere"]);
+    if rgb {
+        header.push("channel");
+    }
+    header.extend(["cos_lo", "cos_hi", "phi_lo_deg", "phi_hi_deg", "energy", "energy_stderr", "bsdf"]);
+    model_rows.write_record(&header)?;
+    let mut comparisons = Vec::new();
+    for (k, &model) in models.iter().enumerate() {
+        let seed = config.seed.wrapping_add(0x9e37_79b9_7f4a_7c15_u64.wrapping_mul(k as u64 + 1));
+        let predictions = predict(model, &config, measured_photons, seed, threads)?;
+        let mut lobes: Vec<(LobeKey, Vec<&Prediction>)> = Vec::new();
+        for p in &predictions {
+            let mut row = p.fields.clone();
+            row.extend([model.name().to_string(), p.key.1.clone(), p.key.2.clone()]);
+            if rgb {
+                row.push(p.key.3.clone());
+            }
+            row.extend(p.bounds.map(|b| b.to_string()));
+            row.extend([p.value.energy, p.value.stderr, p.value.energy / p.solid_angle].map(|v| v.to_string()));
+            model_rows.write_record(&row)?;
+            let lobe = (p.key.0.clone(), p.key.1.clone(), p.key.2.clone(), p.key.3.clone());
+            match lobes.last_mut() {
+                Some((key, bins)) if *key == lobe => bins.push(p),
+                _ => lobes.push((lobe, vec![p])),
+            }
+        }
+        for (key, bins) in lobes {
+            let albedo_measured = summary.get(&key).copied().unwrap_or_default();
+            let model_photons = if model == Model::Single { 0 } else { config.paths };
+            let (test, rel_l1, rel_l2, albedo_model) = compare_lobe(&measured, &bins, measured_photons, model_photons);
+            comparisons.push(LobeComparison {
+                fields: bins[0].fields.clone(),
+                key,
+                model,
+                test,
+                rel_l1,
+                rel_l2,
+                albedo_measured,
+                albedo_model,
+            });
+        }
+    }
+    let mut compare_rows = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<&str> = crate::output::CASE_COLUMNS.to_vec();
+    header.extend(["model", "order", "hemisphere"]);
+    if rgb {
+        header.push("channel");
+    }
+    header.extend([
+        "chi2",
+        "dof",
+        "p_value",
+        "rel_l1",
+        "rel_l2",
+        "albedo_measured",
+        "albedo_measured_stderr",
+        "albedo_model",
+        "albedo_model_stderr",
+        "albedo_diff_se",
+    ]);
+    compare_rows.write_record(&header)?;
+    for c in &comparisons {
+        let mut row = c.fields.clone();
+        row.extend([c.model.name().to_string(), c.key.1.clone(), c.key.2.clone()]);
+        if rgb {
+            row.push(c.key.3.clone());
+        }
+        row.extend([c.test.statistic.to_string(), c.test.dof.to_string(), c.test.p_value.to_string()]);
+        row.extend(
+            [
+                c.rel_l1,
+                c.rel_l2,
+                c.albedo_measured.energy,
+                c.albedo_measured.stderr,
+                c.albedo_model.energy,
+                c.albedo_model.stderr,
+                c.albedo_diff_se(),
+            ]
+            .map(|v| v.to_string()),
+        );
+        compare_rows.write_record(&row)?;
+    }
+    write_atomically(
+        run_dir,
+        &[("models.csv", model_rows.into_inner()?), ("compare.csv", compare_rows.into_inner()?)],
+    )?;
+    Ok(report(&comparisons, models))
+}
+
+/// The worst lobes per model: lowest p-values, with their lobe errors and albedo differences.
+fn report(comparisons: &[LobeComparison], models: &[Model]) -> String {
+    let mut out = String::new();
+    for &model in models {
+        let mut mine: Vec<&LobeComparison> = comparisons.iter().filter(|c| c.model == model).collect();
+        if mine.is_empty() {
+            let _ = writeln!(out, "{}: applies to no case of this run", model.name());
+            continue;
+        }
+        mine.sort_by(|a, b| a.test.p_value.total_cmp(&b.test.p_value));
+        let _ = writeln!(out, "{} ({} lobes), worst first:", model.name(), mine.len());
+        let _ = writeln!(
+            out,
+            "  {:>5} {:>5} {:>4} {:>10} {:>6} {:>10} {:>8} {:>8} {:>11}",
+            "case", "order", "hemi", "chi2", "dof", "p", "rel L1", "rel L2", "albedo diff"
+        );
+        for c in mine.iter().take(5) {
+            let _ = writeln!(
+                out,
+                "  {:>5} {:>5} {:>4} {:>10.1} {:>6} {:>10.2e} {:>8.4} {:>8.4} {:>8.1} SE",
+                c.key.0,
+                c.key.1,
+                c.key.2,
+                c.test.statistic,
+                c.test.dof,
+                c.test.p_value,
+                c.rel_l1,
+                c.rel_l2,
+                c.albedo_diff_se()
+            );
+        }
+    }
+    out
+}
