@@ -2,9 +2,10 @@
 //! case, order and hemisphere (THEORY.md §4.7, §9.5).
 //!
 //! Models: `single` (exact single scattering by adaptive quadrature, order 1, conductor and
-//! dielectric facets with the true Smith Lambda and visible normals), `wang-correlated` and
-//! `wang-uncorrelated` (the Wang et al. 2022 chains, Monte Carlo into the same detector with
-//! their own standard errors).
+//! dielectric facets with the true Smith Lambda and visible normals), `heitz-nee` (next-event
+//! estimation along the walk, every order), `wang-correlated` and `wang-uncorrelated` (the
+//! Wang et al. 2022 chains); the Monte Carlo models run into the same detector with their own
+//! standard errors.
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -25,16 +26,18 @@ use crate::{RunOptions, Simulation};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Model {
     Single,
+    HeitzNee,
     WangCorrelated,
     WangUncorrelated,
 }
 
 impl Model {
-    pub const ALL: [Model; 3] = [Model::Single, Model::WangCorrelated, Model::WangUncorrelated];
+    pub const ALL: [Model; 4] = [Model::Single, Model::HeitzNee, Model::WangCorrelated, Model::WangUncorrelated];
 
     pub fn name(self) -> &'static str {
         match self {
             Model::Single => "single",
+            Model::HeitzNee => "heitz-nee",
             Model::WangCorrelated => "wang-correlated",
             Model::WangUncorrelated => "wang-uncorrelated",
         }
@@ -47,6 +50,9 @@ impl Model {
         })
     }
 }
+
+/// Outgoing directions per hit of the next-event estimator.
+const NEE_DIRECTIONS: u32 = 4;
 
 /// A bin's value and standard error.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -157,12 +163,14 @@ fn predict(
                 }
             }
         }
-        Model::WangCorrelated | Model::WangUncorrelated => {
-            let shadowing =
-                if model == Model::WangCorrelated { Shadowing::Correlated } else { Shadowing::Uncorrelated };
+        Model::HeitzNee | Model::WangCorrelated | Model::WangUncorrelated => {
+            let estimator = match model {
+                Model::WangCorrelated => Estimator::Wang(Shadowing::Correlated),
+                Model::WangUncorrelated => Estimator::Wang(Shadowing::Uncorrelated),
+                _ => Estimator::HeitzNee(NEE_DIRECTIONS),
+            };
             let model_config = Config { seed, ..config.clone() };
-            let options =
-                RunOptions { estimator: Estimator::Wang(shadowing), shard: Shard::WHOLE, threads, show_progress: true };
+            let options = RunOptions { estimator, shard: Shard::WHOLE, threads, show_progress: true };
             let sim = crate::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))?;
             for_each_lobe(&sim, &mut |case, order, hemisphere, channel, value| {
                 rows(case, order, hemisphere, channel, value, &mut out)

@@ -7,6 +7,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use indicatif::ProgressBar;
 use microsurface::facet::{Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Lambertian};
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
+use microsurface::nee::NextEvent;
 use microsurface::normals::Normals;
 use microsurface::smith::Smith;
 use microsurface::walk::{EnergyPolicy, Microsurface};
@@ -53,6 +54,9 @@ pub enum Estimator {
     Walk,
     /// The Wang et al. 2022 chain with the given shadowing model (§6.5).
     Wang(Shadowing),
+    /// Next-event estimation along the walk (Heitz et al. 2016 `eval`, §4.7), with this many
+    /// outgoing directions per hit.
+    HeitzNee(u32),
 }
 
 /// What every case of a run shares.
@@ -101,6 +105,10 @@ fn mix(mut z: u64) -> u64 {
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
 }
+
+/// Seed offset of the next-event estimator's own streams (directions, stochastic phases), so
+/// that the walk underneath uses exactly the measurement's streams.
+const NEE_STREAMS: u64 = 0x6e65_655f_7374_7265;
 
 /// The random stream of one chunk of one case, derived from (seed, case, chunk) only.
 pub fn chunk_rng(seed: u64, case: usize, chunk: u64) -> Pcg64Mcg {
@@ -219,10 +227,16 @@ where
         let mut rng = chunk_rng(w.settings.seed, w.case.index, chunk);
         let mut stack = Vec::new();
         let policy = &w.settings.policy;
+        let mut nee_rng = chunk_rng(w.settings.seed ^ NEE_STREAMS, w.case.index, chunk);
         for _ in 0..w.settings.chunk_photons(chunk) {
             let interactions = match w.settings.estimator {
                 Estimator::Walk => w.surface.trace(&w.facet, policy, wi, &mut rng, &mut stack, detector),
                 Estimator::Wang(shadowing) => shadowing.trace(&w.surface.ndf, &w.facet, policy, wi, &mut rng, detector),
+                Estimator::HeitzNee(samples) => {
+                    let (ndf, facet, sink) = (&w.surface.ndf, &w.facet, &mut *detector);
+                    let mut nee = NextEvent { ndf, facet, sink, rng: &mut nee_rng, samples };
+                    w.surface.trace(&w.facet, policy, wi, &mut rng, &mut stack, &mut nee)
+                }
             };
             detector.end_photon(interactions);
         }

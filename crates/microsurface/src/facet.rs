@@ -10,6 +10,7 @@ use glam::DVec3;
 use rand::Rng;
 
 use crate::fresnel;
+use crate::ndf::Ndf;
 use crate::random::open01;
 use crate::roots::newton_bisect;
 
@@ -55,6 +56,33 @@ pub trait Facet<const C: usize>: Send + Sync {
     /// The interaction of light arriving from `w` (pointing away from the facet) with a facet
     /// of normal `m`, `w·m > 0`, on `side` of the surface.
     fn interact<R: Rng + ?Sized>(&self, w: DVec3, m: DVec3, side: Side, rng: &mut R) -> Interaction<C>;
+
+    /// The phase function of the microsurface's hit facets (§4.2–§4.5): the density, per unit
+    /// solid angle of the new travel direction `d`, of leaving a hit with incident direction
+    /// `w` through the reflecting (`crosses = false`) or refracting branch, times its
+    /// per-channel weight. Directions are in the frame of the ray's side (flipped inside,
+    /// §4.3), where `eta` is the relative index seen by the ray. Facets without a closed form
+    /// evaluate it stochastically with one visible normal from `rng` (unbiased, §4.4).
+    fn phase<N: Ndf, R: Rng + ?Sized>(
+        &self,
+        ndf: &N,
+        w: DVec3,
+        d: DVec3,
+        side: Side,
+        crosses: bool,
+        rng: &mut R,
+    ) -> [f64; C];
+}
+
+/// `D(h) / (4 A(w))`: the density of mirror-reflected directions `w -> d` (§3.1), 0 when the
+/// half vector faces away; returns it with the cosine `w·h` for the Fresnel factor.
+fn mirror_density<N: Ndf>(ndf: &N, w: DVec3, d: DVec3) -> Option<(f64, f64)> {
+    let h = (w + d).normalize();
+    let c = w.dot(h);
+    if !(h.z > 0.0 && c > 0.0) {
+        return None;
+    }
+    Some((ndf.d(h) / (4.0 * ndf.projected_area(w)), c))
 }
 
 /// Mirror reflection of `w` about `m`: `2 (w·m) m - w`.
@@ -102,6 +130,28 @@ impl<const C: usize> Facet<C> for Conductor<C> {
         };
         Interaction::One(Branch { dir: reflect(w, m), weight, crosses: false })
     }
+
+    fn phase<N: Ndf, R: Rng + ?Sized>(
+        &self,
+        ndf: &N,
+        w: DVec3,
+        d: DVec3,
+        _side: Side,
+        crosses: bool,
+        _rng: &mut R,
+    ) -> [f64; C] {
+        match mirror_density(ndf, w, d) {
+            Some((density, c)) if !crosses => {
+                let f: [f64; C] = match self.fresnel {
+                    ConductorFresnel::None => [1.0; C],
+                    ConductorFresnel::Schlick { f0 } => f0.map(|f0| fresnel::schlick(f0, c)),
+                    ConductorFresnel::Exact { eta, k } => std::array::from_fn(|i| fresnel::conductor(eta[i], k[i], c)),
+                };
+                f.map(|f| f * density)
+            }
+            _ => [0.0; C],
+        }
+    }
 }
 
 /// Smooth dielectric facets of relative index `eta = n_inside / n_outside` (§4.3): reflect
@@ -127,6 +177,39 @@ impl<const C: usize> Facet<C> for Dielectric {
             _ => Interaction::One(reflected),
         }
     }
+
+    fn phase<N: Ndf, R: Rng + ?Sized>(
+        &self,
+        ndf: &N,
+        w: DVec3,
+        d: DVec3,
+        side: Side,
+        crosses: bool,
+        _rng: &mut R,
+    ) -> [f64; C] {
+        let eta = match side {
+            Side::Outside => self.eta,
+            Side::Inside => 1.0 / self.eta,
+        };
+        if !crosses {
+            return match mirror_density(ndf, w, d) {
+                Some((density, c)) => [fresnel::dielectric(eta, c) * density; C],
+                None => [0.0; C],
+            };
+        }
+        // Refraction (§4.3): h ∝ -(w + eta d), oriented up; needs w·h > 0 > d·h.
+        let mut h = -(w + eta * d).normalize();
+        if h.z < 0.0 {
+            h = -h;
+        }
+        let (ci, co) = (w.dot(h), d.dot(h));
+        if !(h.z > 0.0 && ci > 0.0 && co < 0.0) {
+            return [0.0; C];
+        }
+        let visible = ci * ndf.d(h) / ndf.projected_area(w);
+        let denom = ci + eta * co;
+        [(1.0 - fresnel::dielectric(eta, ci)) * visible * eta * eta * -co / (denom * denom); C]
+    }
 }
 
 /// Lambertian facets of albedo `rho` (§4.4): cosine-distributed exit about `m`.
@@ -141,6 +224,22 @@ impl<const C: usize> Facet<C> for Lambertian<C> {
         let cos_theta = (1.0 - u).sqrt();
         let dir = about_normal(m, cos_theta, 2.0 * PI * open01(rng));
         Interaction::One(Branch { dir, weight: self.albedo, crosses: false })
+    }
+
+    fn phase<N: Ndf, R: Rng + ?Sized>(
+        &self,
+        ndf: &N,
+        w: DVec3,
+        d: DVec3,
+        _side: Side,
+        crosses: bool,
+        rng: &mut R,
+    ) -> [f64; C] {
+        if crosses {
+            return [0.0; C];
+        }
+        let cosine = ndf.sample_visible(w, rng).dot(d).max(0.0) / PI;
+        self.albedo.map(|a| a * cosine)
     }
 }
 
@@ -161,7 +260,32 @@ impl<const C: usize> Facet<C> for Hammon<C> {
         let weight = std::array::from_fn(|i| (1.0 - f[i]) * self.albedo[i]);
         Interaction::Two(specular, Branch { dir, weight, crosses: false })
     }
+
+    fn phase<N: Ndf, R: Rng + ?Sized>(
+        &self,
+        ndf: &N,
+        w: DVec3,
+        d: DVec3,
+        _side: Side,
+        crosses: bool,
+        rng: &mut R,
+    ) -> [f64; C] {
+        if crosses {
+            return [0.0; C];
+        }
+        let specular = mirror_density(ndf, w, d);
+        let m = ndf.sample_visible(w, rng);
+        let (ci, co) = (w.dot(m), d.dot(m).max(0.0));
+        let exit = HAMMON_K * (1.0 - (1.0 - co).powi(5)) * co;
+        std::array::from_fn(|i| {
+            let spec = specular.map_or(0.0, |(density, c)| fresnel::schlick(self.f0[i], c) * density);
+            spec + (1.0 - fresnel::schlick(self.f0[i], ci)) * self.albedo[i] * exit
+        })
+    }
 }
+
+/// Hammon's normalization of the Fresnel-weighted exit lobe, `k = 21 / (20 pi)` (§4.5).
+const HAMMON_K: f64 = 21.0 / (20.0 * PI);
 
 /// The direction at polar angle `acos(cos_theta)` and azimuth `phi` about the unit vector `m`.
 #[inline]

@@ -60,6 +60,9 @@ pub trait Observer<const C: usize> {
     fn escape(&mut self, order: u32, side: Side, dir: DVec3, weight: &[f64; C]);
     /// A ray stops for `loss`, carrying `weight`.
     fn lose(&mut self, loss: Loss, weight: &[f64; C]);
+    /// A ray hits its `order`-th facet at optical depth `tau` on `side`, travelling along `d`
+    /// with `weight`, before the facet acts (for next-event estimation, §4.7).
+    fn hit(&mut self, _order: u32, _tau: f64, _side: Side, _d: DVec3, _weight: &[f64; C]) {}
 }
 
 /// A ray of the walk: optical depth on its own side, travel direction, side, weight and
@@ -154,6 +157,7 @@ impl<N: Ndf> Microsurface<N> {
                 observer.lose(Loss::Runaway, &ray.beta);
                 break;
             }
+            observer.hit(ray.order, ray.tau, ray.side, ray.d, &ray.beta);
             let m_flipped = self.normals.sample(&self.ndf, d, rng);
             let m = match ray.side {
                 Side::Outside => m_flipped,
