@@ -13,6 +13,7 @@
 //! * [`facet`]: the micro-BSDF of a single facet (conductor, dielectric, Lambertian, Hammon);
 //! * [`walk`]: the random walk of Heitz et al. 2016 that composes them;
 //! * [`single`]: exact single scattering, the walk's order-1 oracle;
+//! * [`slope`]: closed-form GGX masses of slope-space polygons (exact histogram oracles);
 //! * [`nee`]: next-event estimation, a second estimator of the walk's lobes;
 //! * [`wang`]: the position-free models of Wang et al. 2022 as height-free chains;
 //! * [`random`], [`roots`]: variates and the root finder behind the inverse-CDF samplers.
@@ -28,6 +29,7 @@ pub mod normals;
 pub mod random;
 pub mod roots;
 pub mod single;
+pub mod slope;
 pub mod smith;
 pub mod walk;
 pub mod wang;
