@@ -66,37 +66,63 @@ type BinKey = (String, String, String, String, String, String);
 /// Key of one lobe: case, order, hemisphere, channel.
 type LobeKey = (String, String, String, String);
 
-/// The measured bins of a run directory's `lobes.csv`, with the photon count per bin.
-fn read_lobes(path: &Path) -> Result<HashMap<BinKey, (Value, u64)>> {
-    let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let headers = reader.headers()?.clone();
-    let col = |name: &str| {
-        headers.iter().position(|h| h == name).with_context(|| format!("{}: no column {name}", path.display()))
-    };
-    let (case, order, hemi, cos_lo, phi_lo, energy, se, count) = (
-        col("case")?,
-        col("order")?,
-        col("hemisphere")?,
-        col("cos_lo")?,
-        col("phi_lo_deg")?,
-        col("energy")?,
-        col("energy_stderr")?,
-        col("count")?,
-    );
-    let channel = headers.iter().position(|h| h == "channel");
+/// A CSV table of a run directory, read whole, with its columns found by name.
+struct Table {
+    path: std::path::PathBuf,
+    headers: csv::StringRecord,
+    records: Vec<csv::StringRecord>,
+}
+
+impl Table {
+    fn read(path: &Path) -> Result<Self> {
+        let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
+        let headers = reader.headers()?.clone();
+        let records = reader.records().collect::<Result<Vec<_>, _>>()?;
+        Ok(Self { path: path.to_path_buf(), headers, records })
+    }
+
+    fn column(&self, name: &str) -> Result<usize> {
+        self.headers
+            .iter()
+            .position(|h| h == name)
+            .with_context(|| format!("{}: no column {name}", self.path.display()))
+    }
+
+    /// The lobe key of every record: case, order, hemisphere, channel ("" for mono runs).
+    fn lobe_keys(&self) -> Result<Vec<LobeKey>> {
+        let (case, order, hemi) = (self.column("case")?, self.column("order")?, self.column("hemisphere")?);
+        let channel = self.headers.iter().position(|h| h == "channel");
+        Ok(self
+            .records
+            .iter()
+            .map(|r| {
+                let channel = channel.map_or(String::new(), |c| r[c].to_string());
+                (r[case].to_string(), r[order].to_string(), r[hemi].to_string(), channel)
+            })
+            .collect())
+    }
+}
+
+/// The measured bins of a run directory's `lobes.csv`.
+fn read_lobes(path: &Path) -> Result<HashMap<BinKey, Value>> {
+    let table = Table::read(path)?;
+    let (cos_lo, phi_lo) = (table.column("cos_lo")?, table.column("phi_lo_deg")?);
+    let (energy, se) = (table.column("energy")?, table.column("energy_stderr")?);
     let mut out = HashMap::new();
-    for record in reader.records() {
-        let r = record?;
-        let key = (
-            r[case].to_string(),
-            r[order].to_string(),
-            r[hemi].to_string(),
-            channel.map_or(String::new(), |c| r[c].to_string()),
-            r[cos_lo].to_string(),
-            r[phi_lo].to_string(),
-        );
-        let value = Value { energy: r[energy].parse()?, stderr: r[se].parse()? };
-        out.insert(key, (value, r[count].parse()?));
+    for ((case, order, hemi, channel), r) in table.lobe_keys()?.into_iter().zip(&table.records) {
+        let key = (case, order, hemi, channel, r[cos_lo].to_string(), r[phi_lo].to_string());
+        out.insert(key, Value { energy: r[energy].parse()?, stderr: r[se].parse()? });
+    }
+    Ok(out)
+}
+
+/// The measured albedos of a run directory's `summary.csv`, per lobe.
+fn read_summary(path: &Path) -> Result<HashMap<LobeKey, Value>> {
+    let table = Table::read(path)?;
+    let (albedo, se) = (table.column("albedo")?, table.column("albedo_stderr")?);
+    let mut out = HashMap::new();
+    for (key, r) in table.lobe_keys()?.into_iter().zip(&table.records) {
+        out.insert(key, Value { energy: r[albedo].parse()?, stderr: r[se].parse()? });
     }
     Ok(out)
 }
@@ -271,7 +297,7 @@ fn z_value(m: Moments, n_m: u64, p: Moments, n_p: u64) -> Option<f64> {
 /// Compares one lobe bin by bin with [`z_value`]; bins in which fewer than 5 photons are
 /// expected (from the larger of the two energies) are pooled into one cell.
 fn compare_lobe(
-    measured: &HashMap<BinKey, (Value, u64)>,
+    measured: &HashMap<BinKey, Value>,
     predictions: &[&Prediction],
     photons: u64,
     model_photons: u64,
@@ -281,7 +307,7 @@ fn compare_lobe(
     let (mut l1, mut l2, mut norm1, mut norm2) = (0.0, 0.0, 0.0, 0.0);
     let (mut albedo, mut albedo_var) = (0.0, 0.0);
     for (i, p) in predictions.iter().enumerate() {
-        let m = measured.get(&p.key).map_or(Value::default(), |(v, _)| *v);
+        let m = measured.get(&p.key).copied().unwrap_or_default();
         let (o, e) = (m.energy, p.value.energy);
         l1 += (o - e).abs();
         l2 += (o - e) * (o - e);
@@ -309,30 +335,6 @@ fn compare_lobe(
     let rel_l1 = if norm1 > 0.0 { l1 / norm1 } else { 0.0 };
     let rel_l2 = if norm2 > 0.0 { (l2 / norm2).sqrt() } else { 0.0 };
     (ChiSquare::from_cells(cells), rel_l1, rel_l2, Value { energy: albedo, stderr: albedo_var.sqrt() })
-}
-
-/// The measured albedos of a run directory's `summary.csv`, per lobe.
-fn read_summary(path: &Path) -> Result<HashMap<LobeKey, Value>> {
-    let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let headers = reader.headers()?.clone();
-    let col = |name: &str| {
-        headers.iter().position(|h| h == name).with_context(|| format!("{}: no column {name}", path.display()))
-    };
-    let (case, order, hemi, albedo, se) =
-        (col("case")?, col("order")?, col("hemisphere")?, col("albedo")?, col("albedo_stderr")?);
-    let channel = headers.iter().position(|h| h == "channel");
-    let mut out = HashMap::new();
-    for record in reader.records() {
-        let r = record?;
-        let key = (
-            r[case].to_string(),
-            r[order].to_string(),
-            r[hemi].to_string(),
-            channel.map_or(String::new(), |c| r[c].to_string()),
-        );
-        out.insert(key, Value { energy: r[albedo].parse()?, stderr: r[se].parse()? });
-    }
-    Ok(out)
 }
 
 /// Runs the comparison of `run_dir` with `models` and writes `models.csv` and `compare.csv`
