@@ -10,6 +10,9 @@
 //! height is `2u - 1` and for Gaussian heights `Phi^{-1}(u)`: the law of `u` is the law of the
 //! height for every height distribution (§2.1).
 
+mod common;
+
+use common::dir;
 use microsurface::DVec3;
 use microsurface::height::{Flight, fly, other_side_depth};
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
@@ -21,12 +24,6 @@ use statrs::distribution::{ContinuousCDF, Normal};
 
 const FLIGHTS: u64 = 200_000;
 const BINS: usize = 20;
-
-fn dir(theta_deg: f64, phi_deg: f64) -> DVec3 {
-    let (st, ct) = theta_deg.to_radians().sin_cos();
-    let (sp, cp) = phi_deg.to_radians().sin_cos();
-    DVec3::new(st * cp, st * sp, ct)
-}
 
 /// Standard normal two-sided critical value for level `a`.
 fn z_critical(a: f64) -> f64 {

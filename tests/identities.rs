@@ -2,6 +2,9 @@
 //! independent computation: numerical quadrature of the defining integral, a closed form, or
 //! a value quoted in THEORY.md.
 
+mod common;
+
+use common::dir;
 use std::f64::consts::{PI, TAU};
 
 use microsurface::DVec3;
@@ -9,12 +12,6 @@ use microsurface::facet::{hammon_exit_cdf, hammon_exit_cosine};
 use microsurface::fresnel;
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, beckmann_slope_marginal, ggx_slope_marginal};
 use smithwalk::quadrature::{integrate, integrate_2d};
-
-fn dir(theta_deg: f64, phi_deg: f64) -> DVec3 {
-    let (st, ct) = theta_deg.to_radians().sin_cos();
-    let (sp, cp) = phi_deg.to_radians().sin_cos();
-    DVec3::new(st * cp, st * sp, ct)
-}
 
 const THETAS: [f64; 8] = [5.0, 30.0, 60.0, 85.0, 95.0, 120.0, 150.0, 175.0];
 

@@ -5,6 +5,9 @@
 //! 4*10^5 photons; per order the two directions are compared by a z test with per-photon
 //! variances, at the Sidak level keeping the family (all pairs and orders) at 0.01.
 
+mod common;
+
+use common::dir;
 use microsurface::DVec3;
 use microsurface::facet::{Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Lambertian, Side};
 use microsurface::ndf::{Ggx, Ndf, Roughness};
@@ -74,12 +77,6 @@ fn lobe<N: Ndf, F: Facet<1>>(ndf: N, facet: &F, wi: DVec3, wo: DVec3, seed: u128
         let se = ((point.sum_sq[k] / n - mean * mean) / (n - 1.0)).sqrt();
         (mean / wo.z.abs(), se / wo.z.abs())
     })
-}
-
-fn dir(theta_deg: f64, phi_deg: f64) -> DVec3 {
-    let (st, ct) = theta_deg.to_radians().sin_cos();
-    let (sp, cp) = phi_deg.to_radians().sin_cos();
-    DVec3::new(st * cp, st * sp, ct)
 }
 
 type Pairs = [((f64, f64), (f64, f64)); 3];

@@ -9,6 +9,8 @@
 
 mod common;
 
+use common::dir;
+
 use std::f64::consts::TAU;
 
 use microsurface::DVec3;
@@ -21,12 +23,6 @@ use smithwalk::stats::{WeightedBin, chi_square, sidak};
 const SAMPLES: u64 = 200_000;
 const COS_BINS: usize = 16;
 const PHI_BINS: usize = 16;
-
-fn direction(theta_deg: f64, phi_deg: f64) -> DVec3 {
-    let (st, ct) = theta_deg.to_radians().sin_cos();
-    let (sp, cp) = phi_deg.to_radians().sin_cos();
-    DVec3::new(st * cp, st * sp, ct)
-}
 
 fn bin_of(m: DVec3) -> usize {
     let ic = ((m.z * COS_BINS as f64) as usize).min(COS_BINS - 1);
@@ -124,7 +120,7 @@ fn visible_normals_match_the_visible_normal_density() {
     let level = sidak(0.01, cases.len() + HAMMON_TESTS);
     for (i, (ndf, (ax, ay), (t, p))) in cases.into_iter().enumerate() {
         let r = Roughness { x: ax, y: ay };
-        let w = direction(t, p);
+        let w = dir(t, p);
         let label = format!("{ndf} alpha=({ax},{ay}) w=({t},{p})");
         match ndf {
             "ggx" => check(&Ggx(r), Normals::Visible, w, level, i as u64, &label),
@@ -145,7 +141,7 @@ fn hammon_rejection_samples_the_unweighted_restricted_ndf() {
         ((0.8, 0.3), (150.0, 300.0)),
     ];
     for (i, ((ax, ay), (t, p))) in cases.into_iter().enumerate() {
-        let w = direction(t, p);
+        let w = dir(t, p);
         check(
             &Ggx(Roughness { x: ax, y: ay }),
             Normals::HammonRejection,
@@ -162,7 +158,7 @@ fn hammon_rejection_differs_from_visible_normals() {
     // The test above must be able to tell the two laws apart (§3.3): at 60 deg the Hammon
     // histogram is rejected as a sample of D_w.
     let ndf = Ggx(Roughness::isotropic(0.5));
-    let w = direction(60.0, 0.0);
+    let w = dir(60.0, 0.0);
     let expect = expected(|m| ndf.d(m) * w.dot(m).max(0.0) / ndf.projected_area(w));
     let test = chi_square(&sampled(&ndf, Normals::HammonRejection, w, 7), &expect, SAMPLES, 5.0);
     assert!(test.p_value < 1e-6, "p = {}", test.p_value);

@@ -4,6 +4,7 @@
 use smithwalk::Simulation;
 use smithwalk::config::Config;
 use smithwalk::detector::{Detector, Hemisphere, OrderTallies};
+use smithwalk::microsurface::DVec3;
 use smithwalk::run::CaseResult;
 use smithwalk::stats::WeightedBin;
 
@@ -47,4 +48,11 @@ pub fn albedo(d: &Detector<1>, slot: usize, hemisphere: Hemisphere) -> (f64, f64
         .orders
         .get(slot)
         .map_or((0.0, 0.0), |t| t.albedo[hemisphere as usize].mean_and_stderr(d.tallies.photons, 0))
+}
+
+/// The unit direction at polar angle `theta_deg` and azimuth `phi_deg` (degrees).
+pub fn dir(theta_deg: f64, phi_deg: f64) -> DVec3 {
+    let (st, ct) = theta_deg.to_radians().sin_cos();
+    let (sp, cp) = phi_deg.to_radians().sin_cos();
+    DVec3::new(st * cp, st * sp, ct)
 }
