@@ -5,7 +5,8 @@
 //! dielectric facets with the true Smith Lambda and visible normals), `heitz-nee` (next-event
 //! estimation along the walk, every order), `wang-correlated` and `wang-uncorrelated` (the
 //! Wang et al. 2022 chains); the Monte Carlo models run into the same detector with their own
-//! standard errors.
+//! standard errors. `hammon-fit` is Hammon 2017's closed-form approximation for his facet
+//! (order 1 and all orders), integrated over the bins by quadrature.
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -16,7 +17,7 @@ use microsurface::wang::Shadowing;
 
 use crate::config::Config;
 use crate::detector::{Grid, Hemisphere};
-use crate::models::single_scattering_bins;
+use crate::models::{HammonFitPart, hammon_fit_bins, single_scattering_bins};
 use crate::output::{case_fields, write_atomically};
 use crate::run::{Estimator, Shard};
 use crate::stats::{Cell, ChiSquare};
@@ -26,17 +27,20 @@ use crate::{RunOptions, Simulation};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Model {
     Single,
+    HammonFit,
     HeitzNee,
     WangCorrelated,
     WangUncorrelated,
 }
 
 impl Model {
-    pub const ALL: [Model; 4] = [Model::Single, Model::HeitzNee, Model::WangCorrelated, Model::WangUncorrelated];
+    pub const ALL: [Model; 5] =
+        [Model::Single, Model::HammonFit, Model::HeitzNee, Model::WangCorrelated, Model::WangUncorrelated];
 
     pub fn name(self) -> &'static str {
         match self {
             Model::Single => "single",
+            Model::HammonFit => "hammon-fit",
             Model::HeitzNee => "heitz-nee",
             Model::WangCorrelated => "wang-correlated",
             Model::WangUncorrelated => "wang-uncorrelated",
@@ -186,6 +190,16 @@ fn predict(
                     let tol = 1e-3 / (sim_photons as f64 * grid.bins() as f64);
                     let Some(bins) = single_scattering_bins(case, &grid, h, tol) else { continue };
                     rows(case, 1, h, channel, &mut |i| Value { energy: bins[i], stderr: 0.0 }, &mut out);
+                }
+            }
+        }
+        Model::HammonFit => {
+            let channel = if config.is_rgb() { "r" } else { "" };
+            for case in &cases {
+                for (slot, part) in [(0, HammonFitPart::All), (1, HammonFitPart::Single)] {
+                    let tol = 1e-3 / (sim_photons as f64 * grid.bins() as f64);
+                    let Some(bins) = hammon_fit_bins(case, &grid, part, tol) else { continue };
+                    rows(case, slot, Hemisphere::R, channel, &mut |i| Value { energy: bins[i], stderr: 0.0 }, &mut out);
                 }
             }
         }
@@ -386,7 +400,7 @@ pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Op
         }
         for (key, bins) in lobes {
             let albedo_measured = summary.get(&key).copied().unwrap_or_default();
-            let model_photons = if model == Model::Single { 0 } else { config.paths };
+            let model_photons = if matches!(model, Model::Single | Model::HammonFit) { 0 } else { config.paths };
             let (test, rel_l1, rel_l2, albedo_model) = compare_lobe(&measured, &bins, measured_photons, model_photons);
             comparisons.push(LobeComparison {
                 fields: bins[0].fields.clone(),
