@@ -25,7 +25,7 @@ pgrep -x munged >/dev/null || runuser -u munge -- munged
 munge -n | unmunge >/dev/null
 
 # A one-node cluster on this machine.
-node=$(hostname -s)
+node=$(uname -n | cut -d. -f1)
 cpus=$(nproc)
 mem=$(($(awk '/MemTotal/ {print $2}' /proc/meminfo) / 1024 - 512))
 mkdir -p /etc/slurm /var/spool/slurmctld /var/spool/slurmd /var/log/slurm
