@@ -163,7 +163,7 @@ impl Grid {
 }
 
 /// Which hemisphere light leaves into, relative to where it came from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Hemisphere {
     /// Reflection: back to the side of the light.
     R = 0,
