@@ -27,6 +27,7 @@ const ORDERS: usize = 3;
 struct Point<'a, N, F> {
     ndf: &'a N,
     facet: &'a F,
+    normals: Normals,
     wo: DVec3,
     rng: Pcg64Mcg,
     photon: [f64; ORDERS],
@@ -43,18 +44,49 @@ impl<N: Ndf, F: Facet<1>> Observer<1> for Point<'_, N, F> {
         let k = order as usize - 1;
         if k < ORDERS {
             let (value, _) = contribution(self.ndf, self.facet, tau, side, d, self.wo, &mut self.rng);
-            self.photon[k] += weight[0] * value[0];
+            self.photon[k] += weight[0] * value[0] * self.normal_law_factor(-d);
+        }
+    }
+}
+
+impl<N: Ndf, F> Point<'_, N, F> {
+    /// The phase functions assume visible normals, `D_w(h) = D(h) (w·h) / A(w)`. Hammon's
+    /// sampler draws `D(h) h_z 1[w·h > 0] / N(w)` instead (§3.3), so a mirror facet's phase
+    /// function is scaled by `h_z A(w) / (N(w) (w·h))`, with, for GGX, `N(w) = (1 + w'_z) / 2`
+    /// (`w'` the stretched direction: the cosine-weighted measure of the lune `w'·m > 0`,
+    /// Lambert's formula of §8.1). Only for mirror facets seen from outside.
+    fn normal_law_factor(&self, w: DVec3) -> f64 {
+        match self.normals {
+            Normals::Visible => 1.0,
+            Normals::HammonRejection => {
+                let h = (w + self.wo).normalize();
+                let n = 0.5 * (1.0 + self.ndf.roughness().stretch(w).z);
+                h.z * self.ndf.projected_area(w) / (n * w.dot(h))
+            }
         }
     }
 }
 
 /// Per-order mean and standard error of `f_k(wi, wo)` (the lobe divided by `|cos theta_o|`).
 fn lobe<N: Ndf, F: Facet<1>>(ndf: N, facet: &F, wi: DVec3, wo: DVec3, seed: u128) -> [(f64, f64); ORDERS] {
-    let surface = Microsurface { ndf, smith: Smith::Exact, normals: Normals::Visible };
+    lobe_with(ndf, Smith::Exact, Normals::Visible, facet, wi, wo, seed)
+}
+
+fn lobe_with<N: Ndf, F: Facet<1>>(
+    ndf: N,
+    smith: Smith,
+    normals: Normals,
+    facet: &F,
+    wi: DVec3,
+    wo: DVec3,
+    seed: u128,
+) -> [(f64, f64); ORDERS] {
+    let surface = Microsurface { ndf, smith, normals };
     let policy = EnergyPolicy { split: true, threshold: 0.1 };
     let mut point = Point {
         ndf: &ndf,
         facet,
+        normals,
         wo,
         rng: Pcg64Mcg::new(seed ^ 0xabcdef),
         photon: [0.0; ORDERS],
@@ -130,4 +162,39 @@ fn the_test_detects_a_broken_symmetry() {
     let (f, b) = (lobe(ndf, &facet, wi, wo, 31)[0], lobe(ndf, &facet, wo, wi, 32)[0]);
     let z = (f.0 - b.0) / (f.1 * f.1 + b.1 * b.1).sqrt();
     assert!(z.abs() > 10.0, "z = {z}");
+}
+
+#[test]
+fn hammons_variants_are_not_reciprocal() {
+    // Order 1, conductor F = 1, isotropic GGX 0.5, light at 20 deg and detector at 70 deg.
+    // The measured ratio f_1(wi, wo) / f_1(wo, wi) must match the closed forms:
+    // * symmetric Lambda (§2.7): first-hit depth ~ Exp(Lambda_i), so
+    //   f_1 ∝ Lambda_i / ((1 + Lambda_i)(Lambda_i + Lambda_o)) and the ratio is
+    //   Lambda_i (1 + Lambda_o) / (Lambda_o (1 + Lambda_i));
+    // * Hammon's normals (§3.3 item 1): f_1^H = f_1 h_z A(wi) / (N(wi) (wi·h)), so the ratio is
+    //   A(wi) N(wo) / (N(wi) A(wo)) with N(w) = (1 + w'_z) / 2.
+    // Tolerance: 5 standard errors of the measured ratio (first-order error propagation).
+    let ndf = Ggx(Roughness::isotropic(0.5));
+    let facet = Conductor::<1> { fresnel: ConductorFresnel::None };
+    let (wi, wo) = (dir(20.0, 0.0), dir(70.0, 150.0));
+    let (li, lo) = (ndf.lambda(wi), ndf.lambda(wo));
+    let n = |w: DVec3| 0.5 * (1.0 + ndf.roughness().stretch(w).z);
+    let cases = [
+        ("symmetric Lambda", Smith::Symmetric, Normals::Visible, li * (1.0 + lo) / (lo * (1.0 + li))),
+        (
+            "Hammon normals",
+            Smith::Exact,
+            Normals::HammonRejection,
+            ndf.projected_area(wi) * n(wo) / (n(wi) * ndf.projected_area(wo)),
+        ),
+    ];
+    for (i, (name, smith, normals, expected)) in cases.into_iter().enumerate() {
+        let forward = lobe_with(ndf, smith, normals, &facet, wi, wo, 40 + i as u128)[0];
+        let backward = lobe_with(ndf, smith, normals, &facet, wo, wi, 50 + i as u128)[0];
+        let ratio = forward.0 / backward.0;
+        let se = ratio * ((forward.1 / forward.0).powi(2) + (backward.1 / backward.0).powi(2)).sqrt();
+        println!("{name}: f1(wi,wo)/f1(wo,wi) = {ratio:.4} +- {se:.4}, closed form {expected:.4}");
+        assert!((ratio - 1.0).abs() > 10.0 * se, "{name}: no asymmetry measured ({ratio} +- {se})");
+        assert!((ratio - expected).abs() < 5.0 * se, "{name}: ratio {ratio} +- {se}, expected {expected}");
+    }
 }
