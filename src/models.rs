@@ -1,13 +1,14 @@
-//! Analytic models evaluated in the detector's bins. For now: exact single scattering of
-//! mirror and dielectric facets (THEORY.md §5), integrated over each bin by adaptive
-//! quadrature (§4.7: evaluating at bin centres is biased for peaked lobes).
+//! Analytic models evaluated in the detector's bins, integrated over each bin by adaptive
+//! quadrature (§4.7: evaluating at bin centres is biased for peaked lobes): exact single
+//! scattering of every facet material (§5) and Hammon 2017's closed-form fit.
 
-use std::f64::consts::TAU;
+use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
 use microsurface::fresnel;
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 use microsurface::single;
+use rayon::prelude::*;
 
 use crate::cases::Case;
 use crate::config::{FresnelKind, IncidentSide, MaterialConfig, NdfKind, NormalsKind, SmithKind};
@@ -23,7 +24,7 @@ fn direction(u: f64, phi: f64, phi_i: f64, sign: f64) -> DVec3 {
 }
 
 /// The order-1 cosine-weighted lobe `f_1 |cos theta_o|` of a case at `wo`, channel 0.
-fn single_lobe<N: Ndf>(ndf: &N, material: &MaterialConfig, wi: DVec3, wo: DVec3) -> f64 {
+fn single_lobe<N: Ndf>(ndf: &N, material: &MaterialConfig, wi: DVec3, wo: DVec3, visible: &[(DVec3, f64)]) -> f64 {
     match material {
         MaterialConfig::Conductor { fresnel: kind, f0, eta, k, .. } => {
             let f = |c: f64| match kind {
@@ -45,18 +46,89 @@ fn single_lobe<N: Ndf>(ndf: &N, material: &MaterialConfig, wi: DVec3, wo: DVec3)
                 single::transmission(ndf, wi, wo, eta, |c| fresnel::dielectric(eta, c))
             }
         }
-        MaterialConfig::Diffuse { .. } | MaterialConfig::Hammon { .. } => f64::NAN,
+        MaterialConfig::Diffuse { albedo, .. } => {
+            let rho = albedo.to_array::<1>()[0];
+            exit_lobe(ndf, wi, wo, visible, |_, c| rho * c / PI)
+        }
+        MaterialConfig::Hammon { f0, albedo, .. } => {
+            let (f0, rho) = (f0.to_array::<1>()[0], albedo.to_array::<1>()[0]);
+            let specular = single::reflection(ndf, wi, wo, |c| fresnel::schlick(f0, c));
+            let k = 21.0 / (20.0 * PI);
+            specular
+                + exit_lobe(ndf, wi, wo, visible, |ci, c| {
+                    (1.0 - fresnel::schlick(f0, ci)) * rho * k * (1.0 - (1.0 - c).powi(5)) * c
+                })
+        }
     }
 }
 
+/// Single scattering of facets that scatter about their normal (§5, diffuse facets [HD15] and
+/// Hammon's exit): `G2/G1(wi) ∫ D_wi(m) g(wi·m, <wo·m>) dm`, with the visible-normal integral
+/// taken by the quadrature rule `visible` (nodes and weights of `D_wi`).
+fn exit_lobe<N: Ndf>(ndf: &N, wi: DVec3, wo: DVec3, visible: &[(DVec3, f64)], g: impl Fn(f64, f64) -> f64) -> f64 {
+    if wo.z <= 0.0 {
+        return 0.0;
+    }
+    let escape = (1.0 + ndf.lambda(wi)) * single::g2_reflection(ndf, wi, wo);
+    escape * visible.iter().map(|&(m, w)| w * g(wi.dot(m), wo.dot(m).max(0.0))).sum::<f64>()
+}
+
+/// Gauss–Legendre nodes and weights on [a, b] (Newton iteration on the Legendre polynomial).
+fn gauss_legendre(n: usize, a: f64, b: f64) -> Vec<(f64, f64)> {
+    (0..n)
+        .map(|i| {
+            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 1.0;
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let step = p1 / dp;
+                x -= step;
+                if step.abs() < 1e-15 {
+                    break;
+                }
+            }
+            let w = 2.0 / ((1.0 - x * x) * dp * dp);
+            (0.5 * (a + b) + 0.5 * (b - a) * x, 0.5 * (b - a) * w)
+        })
+        .collect()
+}
+
+/// A quadrature rule for GGX visible normals seen from `wi`: in the stretched configuration
+/// they are `normalize(c + w')` with `c` uniform on the spherical cap `z > -w'_z` (§3.2, [DB23]),
+/// integrated by Gauss–Legendre in `z` and the trapezoid rule in the azimuth.
+fn ggx_visible_rule(ndf: &Ggx, wi: DVec3) -> Vec<(DVec3, f64)> {
+    const NZ: usize = 32;
+    const NPHI: usize = 64;
+    let roughness = ndf.roughness();
+    let ws = roughness.stretch(wi);
+    let mut rule = Vec::with_capacity(NZ * NPHI);
+    for (z, wz) in gauss_legendre(NZ, -ws.z, 1.0) {
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        for j in 0..NPHI {
+            let (sp, cp) = (TAU * (j as f64 + 0.5) / NPHI as f64).sin_cos();
+            let m = roughness.unstretch_normal(DVec3::new(s * cp, s * sp, z) + ws);
+            rule.push((m, wz / (NPHI as f64 * (1.0 + ws.z))));
+        }
+    }
+    rule
+}
+
 /// Expected order-1 energy per photon in every bin of `hemisphere` (index `cos * phi_bins +
-/// phi`), or `None` where the closed form does not apply (diffuse or Hammon facets, Hammon's
-/// Smith or normals, light from inside).
+/// phi`), or `None` where single scattering is not available: Hammon's Smith or normals, light
+/// from inside, or diffuse and Hammon facets on Beckmann (their visible-normal integral uses
+/// the GGX cap rule).
 pub fn single_scattering_bins(case: &Case, grid: &Grid, hemisphere: Hemisphere, abs_tol: f64) -> Option<Vec<f64>> {
+    let scatters_about_normal = matches!(case.material, MaterialConfig::Diffuse { .. } | MaterialConfig::Hammon { .. });
     if case.smith != SmithKind::Exact
         || case.normals != NormalsKind::Vndf
         || case.side != IncidentSide::Outside
-        || matches!(case.material, MaterialConfig::Diffuse { .. } | MaterialConfig::Hammon { .. })
+        || (scatters_about_normal && case.ndf != NdfKind::Ggx)
     {
         return None;
     }
@@ -72,7 +144,25 @@ fn bins_for<N: Ndf>(ndf: &N, case: &Case, grid: &Grid, hemisphere: Hemisphere, a
         return vec![0.0; grid.bins()];
     }
     let wi = case.incident_direction();
-    integrate_bins(case, grid, hemisphere, abs_tol, |wo| single_lobe(ndf, &case.material, wi, wo))
+    let visible = match (&case.material, case.ndf) {
+        (MaterialConfig::Diffuse { .. } | MaterialConfig::Hammon { .. }, NdfKind::Ggx) => {
+            ggx_visible_rule(&Ggx(Roughness { x: case.alpha_x, y: case.alpha_y }), wi)
+        }
+        _ => Vec::new(),
+    };
+    // The exit lobes are sums over the visible-normal rule with a kink per node, where adaptive
+    // refinement crawls; a fixed 12 x 12 Gauss–Legendre rule per bin resolves them instead.
+    let rule = if visible.is_empty() { BinRule::Adaptive(abs_tol) } else { BinRule::GaussLegendre(12) };
+    integrate_bins(case, grid, hemisphere, rule, |wo| single_lobe(ndf, &case.material, wi, wo, &visible))
+}
+
+/// How a lobe is integrated over a bin.
+#[derive(Clone, Copy, Debug)]
+enum BinRule {
+    /// Adaptive Gauss–Kronrod to this absolute tolerance.
+    Adaptive(f64),
+    /// A fixed `n x n` Gauss–Legendre product rule.
+    GaussLegendre(usize),
 }
 
 /// Integrates a cosine-weighted lobe `wo -> f(wi, wo) |cos theta_o|` over every bin of
@@ -81,8 +171,8 @@ fn integrate_bins(
     case: &Case,
     grid: &Grid,
     hemisphere: Hemisphere,
-    abs_tol: f64,
-    lobe: impl Fn(DVec3) -> f64,
+    rule: BinRule,
+    lobe: impl Fn(DVec3) -> f64 + Sync,
 ) -> Vec<f64> {
     let phi_i = case.phi_i_deg.to_radians();
     let sign = match hemisphere {
@@ -90,15 +180,22 @@ fn integrate_bins(
         Hemisphere::T => -1.0,
     };
     let dphi = TAU / grid.phi_bins as f64;
-    let mut out = Vec::with_capacity(grid.bins());
-    for ic in 0..grid.cos_bins {
-        let (lo, hi) = grid.cos_edges(ic);
-        for ip in 0..grid.phi_bins {
+    (0..grid.bins())
+        .into_par_iter()
+        .map(|bin| {
+            let (lo, hi) = grid.cos_edges(bin / grid.phi_bins);
+            let ip = bin % grid.phi_bins;
             let phi = (ip as f64 * dphi, (ip + 1) as f64 * dphi);
-            out.push(integrate_2d(|u, p| lobe(direction(u, p, phi_i, sign)), (lo, hi), phi, abs_tol).0);
-        }
-    }
-    out
+            let f = |u: f64, p: f64| lobe(direction(u, p, phi_i, sign));
+            match rule {
+                BinRule::Adaptive(tol) => integrate_2d(f, (lo, hi), phi, tol).0,
+                BinRule::GaussLegendre(n) => {
+                    let (us, ps) = (gauss_legendre(n, lo, hi), gauss_legendre(n, phi.0, phi.1));
+                    us.iter().map(|&(u, wu)| ps.iter().map(|&(p, wp)| wu * wp * f(u, p)).sum::<f64>()).sum()
+                }
+            }
+        })
+        .collect()
 }
 
 /// Which part of Hammon's fit to evaluate.
@@ -148,7 +245,7 @@ pub fn hammon_fit_bins(case: &Case, grid: &Grid, part: HammonFitPart, abs_tol: f
     }
     let (f0, albedo) = (f0.to_array::<1>()[0], albedo.to_array::<1>()[0]);
     let wi = case.incident_direction();
-    Some(integrate_bins(case, grid, Hemisphere::R, abs_tol, |wo| {
+    Some(integrate_bins(case, grid, Hemisphere::R, BinRule::Adaptive(abs_tol), |wo| {
         hammon_fit_lobe(case.alpha_x, f0, albedo, wi, wo, part)
     }))
 }

@@ -155,3 +155,45 @@ fn order_one_albedo_to_four_decimals() {
         assert!((e - e1).abs() < 5e-5, "alpha {alpha} theta {theta}: E1 = {e} +- {se}, expected {e1} to 4 decimals");
     }
 }
+
+#[test]
+fn order_one_of_scattering_facets_matches_single_scattering() {
+    // Lambertian and Hammon facets on GGX (§5: the visible-normal integral by a Gauss–Legendre
+    // rule on the [DB23] cap, then adaptive quadrature over each bin), 10^6 photons, 8 x 16
+    // bins, cells with expected count < 5 pooled, Sidak family level 0.01 over the 4 cases.
+    let cases = [
+        ("alpha = 0.3", "kind = \"diffuse\"\nalbedo = 0.8", 0.0),
+        ("alpha = [[0.9, 0.4]]", "kind = \"diffuse\"", 80.0),
+        ("alpha = 0.6", "kind = \"hammon\"\nf0 = 0.04\nalbedo = 0.75", 45.0),
+        ("alpha = 1.0", "kind = \"hammon\"\nf0 = 0.02\nalbedo = 1.0", 82.0),
+    ];
+    let level = sidak(0.01, cases.len());
+    for (i, (alpha, material, theta)) in cases.into_iter().enumerate() {
+        let toml = format!(
+            "paths = 1_000_000\nseed = {}\n[surface]\n{alpha}\n[material]\n{material}\n[incident]\ntheta_deg = {theta}\nphi_deg = 15\n[detector]\ncos_theta_bins = 8\nphi_bins = 16\nmax_order = 2\n",
+            150 + i
+        );
+        let sim = simulate(&toml, 2);
+        let d = mono(&sim, 0);
+        let expected = single_scattering_bins(&sim.cases[0], &d.grid, Hemisphere::R, 1e-9).expect("GGX");
+        let test = chi_square(&weighted_bins(d, 1, Hemisphere::R), &expected, d.tallies.photons, 5.0);
+        assert!(test.p_value > level, "{material} {alpha} at {theta} deg: order 1 rejected\n{}", test.worst_cells(10));
+    }
+}
+
+#[test]
+fn lambertian_single_scattering_albedo_matches_the_formula_values() {
+    // THEORY.md §9.4: E1 of Lambertian facets (rho = 1, isotropic GGX) by the [HD15] formula,
+    // 10^6 samples there (SE about 5e-4): 0.7805 (alpha 0.5, 0 deg), 0.7557 (0.5, 60 deg),
+    // 0.5817 (1.0, 0 deg), 0.5647 (1.0, 60 deg). Our quadrature over a 4 x 8 grid.
+    let grid = smithwalk::detector::Grid { cos_bins: 4, phi_bins: 8 };
+    for (alpha, theta, reference) in [(0.5, 0.0, 0.7805), (0.5, 60.0, 0.7557), (1.0, 0.0, 0.5817), (1.0, 60.0, 0.5647)]
+    {
+        let toml = format!(
+            "paths = 10\n[surface]\nalpha = {alpha}\n[material]\nkind = \"diffuse\"\n[incident]\ntheta_deg = {theta}\n"
+        );
+        let case = smithwalk::cases::expand(&smithwalk::config::Config::parse(&toml).unwrap())[0].clone();
+        let e1: f64 = single_scattering_bins(&case, &grid, Hemisphere::R, 1e-9).unwrap().iter().sum();
+        assert!((e1 - reference).abs() < 2e-3, "alpha {alpha} theta {theta}: E1 = {e1}, formula {reference}");
+    }
+}
