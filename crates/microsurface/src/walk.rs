@@ -182,20 +182,32 @@ impl<N: Ndf> Microsurface<N> {
                 observer.lose(Loss::Invalid, &ray.beta);
                 break;
             }
-            let largest = max_channel(&ray.beta);
-            if largest == 0.0 {
-                break;
-            }
-            if largest < policy.threshold {
-                let survive = largest / policy.threshold;
-                if open01(rng) >= survive {
-                    break;
-                }
-                ray.beta = ray.beta.map(|b| b / survive);
+            match roulette(&ray.beta, policy.threshold, rng) {
+                Some(beta) => ray.beta = beta,
+                None => break,
             }
         }
         ray.order - start
     }
+}
+
+/// Russian roulette on a path weight (§4.6): `None` if the path ends (no weight left, or it
+/// loses the roulette that weights whose largest channel is below `threshold` play), else the
+/// weight to carry on with (divided by the survival probability).
+pub(crate) fn roulette<R: Rng + ?Sized, const C: usize>(
+    weight: &[f64; C],
+    threshold: f64,
+    rng: &mut R,
+) -> Option<[f64; C]> {
+    let largest = max_channel(weight);
+    if largest == 0.0 {
+        return None;
+    }
+    if largest >= threshold {
+        return Some(*weight);
+    }
+    let survive = largest / threshold;
+    (open01(rng) < survive).then(|| weight.map(|w| w / survive))
 }
 
 /// The ray that follows `branch`.

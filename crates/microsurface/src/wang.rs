@@ -23,7 +23,7 @@ use statrs::function::gamma::ln_gamma;
 use crate::facet::{Facet, Interaction, Side};
 use crate::ndf::Ndf;
 use crate::random::open01;
-use crate::walk::{EnergyPolicy, Loss, Observer, RUNAWAY_ORDER, choose};
+use crate::walk::{EnergyPolicy, Loss, Observer, RUNAWAY_ORDER, choose, roulette};
 
 /// The shadowing model of the chain (§6.3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -111,16 +111,9 @@ impl Shadowing {
                 observer.escape(order, side, d, &weight.map(|w| w * p));
                 weight = weight.map(|w| w * (1.0 - p));
             }
-            let largest = weight.iter().copied().fold(0.0, f64::max);
-            if largest == 0.0 {
-                return u64::from(order);
-            }
-            if largest < policy.threshold {
-                let survive = largest / policy.threshold;
-                if open01(rng) >= survive {
-                    return u64::from(order);
-                }
-                weight = weight.map(|w| w / survive);
+            match roulette(&weight, policy.threshold, rng) {
+                Some(w) => weight = w,
+                None => return u64::from(order),
             }
         }
     }
