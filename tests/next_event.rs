@@ -22,18 +22,10 @@
 
 mod common;
 
-use common::{albedo, bin_counts, mono, weighted_bins};
-use smithwalk::config::Config;
+use common::{albedo, bin_counts, mono, simulate_with, weighted_bins};
 use smithwalk::detector::Hemisphere;
-use smithwalk::run::{Estimator, Shard};
+use smithwalk::run::Estimator;
 use smithwalk::stats::{sidak, two_sample};
-use smithwalk::{RunOptions, Simulation};
-
-fn run(toml: &str, estimator: Estimator) -> Simulation {
-    let config = Config::parse(toml).unwrap();
-    let options = RunOptions { estimator, shard: Shard::WHOLE, threads: Some(2), show_progress: false };
-    smithwalk::simulate_from(&config, &options, None, &mut |_, _, _| Ok(())).unwrap()
-}
 
 const CASES: [(&str, &str, &str, &[Hemisphere]); 6] = [
     ("ndf = \"ggx\"\nalpha = 0.8", "kind = \"conductor\"", "theta_deg = 40", &[Hemisphere::R]),
@@ -83,8 +75,8 @@ fn next_event_estimation_agrees_with_the_histogram_for_every_order() {
                 "paths = {paths}\nseed = {seed}\n[surface]\n{surface}\n[material]\n{material}\n[incident]\n{incident}\n[detector]\ncos_theta_bins = 8\nphi_bins = 16\nmax_order = 6\n"
             )
         };
-        let hist = run(&toml(1_000_000, 1300 + i as u64), Estimator::Walk);
-        let nee = run(&toml(400_000, 1400 + i as u64), Estimator::HeitzNee(4));
+        let hist = simulate_with(&toml(1_000_000, 1300 + i as u64), Estimator::Walk);
+        let nee = simulate_with(&toml(400_000, 1400 + i as u64), Estimator::HeitzNee(4));
         let (a, b) = (mono(&hist, 0), mono(&nee, 0));
         let slots: &[usize] = if all_orders { &lobe_slots } else { &lobe_slots[1..2] };
         for &h in hemispheres {

@@ -14,21 +14,14 @@
 
 mod common;
 
-use common::{albedo, mono, weighted_bins};
+use common::{albedo, mono, simulate_with, weighted_bins};
 use microsurface::wang::Shadowing;
-use smithwalk::config::Config;
+use smithwalk::Simulation;
 use smithwalk::detector::Hemisphere;
 use smithwalk::models::single_scattering_bins;
 use smithwalk::output::EnergyBalance;
-use smithwalk::run::{Estimator, Shard};
+use smithwalk::run::Estimator;
 use smithwalk::stats::{chi_square, sidak};
-use smithwalk::{RunOptions, Simulation};
-
-fn run(toml: &str, estimator: Estimator) -> Simulation {
-    let config = Config::parse(toml).unwrap();
-    let options = RunOptions { estimator, shard: Shard::WHOLE, threads: Some(2), show_progress: false };
-    smithwalk::simulate_from(&config, &options, None, &mut |_, _, _| Ok(())).unwrap()
-}
 
 fn conductor(alpha: f64, theta: f64, seed: u64) -> String {
     format!(
@@ -53,7 +46,7 @@ fn per_order_albedos_match_the_independent_chains() {
     let rounding: f64 = 5e-5 / 3f64.sqrt();
     for (i, (alpha, theta, corr, uncorr)) in table.into_iter().enumerate() {
         for (estimator, row, name) in [(CORRELATED, corr, "correlated"), (UNCORRELATED, uncorr, "uncorrelated")] {
-            let sim = run(&conductor(alpha, theta, 1000 + i as u64), estimator);
+            let sim = simulate_with(&conductor(alpha, theta, 1000 + i as u64), estimator);
             let d = mono(&sim, 0);
             for (k, &reference) in row.iter().enumerate() {
                 let (e, se) = albedo(d, k + 1, Hemisphere::R);
@@ -87,7 +80,7 @@ fn correlated_order_one_is_exact_single_scattering() {
             "paths = 1_000_000\nseed = {}\n[surface]\n{alpha}\n[material]\n{material}\n[incident]\ntheta_deg = {theta}\nphi_deg = 20\n[detector]\ncos_theta_bins = 16\nphi_bins = 32\nmax_order = 2\n",
             1100 + i
         );
-        let sim = run(&toml, CORRELATED);
+        let sim = simulate_with(&toml, CORRELATED);
         let d = mono(&sim, 0);
         for &h in hemispheres {
             let expected = single_scattering_bins(&sim.cases[0], &d.grid, h, 1e-10).unwrap();
@@ -107,8 +100,8 @@ fn the_discrepancy_patterns_of_the_supplement_hold() {
     let beyond = |a: (f64, f64), b: (f64, f64)| (a.0 - b.0) / (a.1 * a.1 + b.1 * b.1).sqrt();
     // Claim 1 (§6.6): the correlated model puts too much energy in order 2 and too little in
     // orders >= 3, most at alpha 1, normal incidence.
-    let walk = run(&conductor(1.0, 0.0, 1200), Estimator::Walk);
-    let corr = run(&conductor(1.0, 0.0, 1201), CORRELATED);
+    let walk = simulate_with(&conductor(1.0, 0.0, 1200), Estimator::Walk);
+    let corr = simulate_with(&conductor(1.0, 0.0, 1201), CORRELATED);
     let (w2, c2) = (albedo(mono(&walk, 0), 2, Hemisphere::R), albedo(mono(&corr, 0), 2, Hemisphere::R));
     assert!(beyond(c2, w2) > 5.0, "E2: correlated {c2:?} vs walk {w2:?}");
     assert!(c2.0 / w2.0 > 1.2, "E2 excess at alpha 1, 0 deg: {}", c2.0 / w2.0);
@@ -121,8 +114,8 @@ fn the_discrepancy_patterns_of_the_supplement_hold() {
     // Claim 2: the uncorrelated model deviates mostly at grazing incidence (order 1 is exact
     // at normal incidence, off at 80 deg).
     let gap = |theta: f64, seed: u64| {
-        let w = albedo(mono(&run(&conductor(1.0, theta, seed), Estimator::Walk), 0), 1, Hemisphere::R);
-        let u = albedo(mono(&run(&conductor(1.0, theta, seed + 1), UNCORRELATED), 0), 1, Hemisphere::R);
+        let w = albedo(mono(&simulate_with(&conductor(1.0, theta, seed), Estimator::Walk), 0), 1, Hemisphere::R);
+        let u = albedo(mono(&simulate_with(&conductor(1.0, theta, seed + 1), UNCORRELATED), 0), 1, Hemisphere::R);
         beyond(w, u)
     };
     let (normal, grazing) = (gap(0.0, 1210), gap(80.0, 1220));
@@ -134,7 +127,7 @@ fn the_discrepancy_patterns_of_the_supplement_hold() {
 fn both_models_conserve_energy() {
     let toml = "paths = 50_000\nseed = 7\n[surface]\nndf = [\"ggx\", \"beckmann\"]\nalpha = [0.2, 1.0, [2.0, 0.3]]\n[[material]]\nkind = \"conductor\"\n[[material]]\nkind = \"diffuse\"\n[[material]]\nkind = \"dielectric\"\neta = 1.5\n[incident]\ntheta_deg = [0, 50, 85]\n[detector]\ncos_theta_bins = 2\nphi_bins = 2\nmax_order = 3\n";
     for estimator in [CORRELATED, UNCORRELATED] {
-        let sim = run(toml, estimator);
+        let sim = simulate_with(toml, estimator);
         for (case, r) in sim.cases.iter().zip(&sim.results) {
             let e = EnergyBalance::from_result(r);
             assert_eq!(e.lost(), 0.0);

@@ -14,6 +14,18 @@ pub fn simulate(toml: &str, threads: usize) -> Simulation {
     smithwalk::simulate(&config, Some(threads), false).expect("simulation runs")
 }
 
+/// Parses a TOML config and runs it with `estimator` (the walk or a model) on 2 threads.
+pub fn simulate_with(toml: &str, estimator: smithwalk::run::Estimator) -> Simulation {
+    let config = Config::parse(toml).expect("test config is valid");
+    let options = smithwalk::RunOptions {
+        estimator,
+        shard: smithwalk::run::Shard::WHOLE,
+        threads: Some(2),
+        show_progress: false,
+    };
+    smithwalk::simulate_from(&config, &options, None, &mut |_, _, _| Ok(())).expect("simulation runs")
+}
+
 /// The single-channel detector of case `i`.
 pub fn mono(sim: &Simulation, i: usize) -> &Detector<1> {
     match &sim.results[i] {
