@@ -181,23 +181,22 @@ fn predict(
             }
         }
     };
+    // Closed-form models: channel 0 of RGB runs, and a quadrature error far below the
+    // statistical error of the measurement.
+    let channel = if config.is_rgb() { "r" } else { "" };
+    let tol = 1e-3 / (sim_photons as f64 * grid.bins() as f64);
     match model {
         Model::Single => {
-            let channel = if config.is_rgb() { "r" } else { "" };
             for case in &cases {
                 for &h in crate::output::hemispheres(case) {
-                    // Quadrature error far below the statistical error of the measurement.
-                    let tol = 1e-3 / (sim_photons as f64 * grid.bins() as f64);
                     let Some(bins) = single_scattering_bins(case, &grid, h, tol) else { continue };
                     rows(case, 1, h, channel, &mut |i| Value { energy: bins[i], stderr: 0.0 }, &mut out);
                 }
             }
         }
         Model::HammonFit => {
-            let channel = if config.is_rgb() { "r" } else { "" };
             for case in &cases {
                 for (slot, part) in [(0, HammonFitPart::All), (1, HammonFitPart::Single)] {
-                    let tol = 1e-3 / (sim_photons as f64 * grid.bins() as f64);
                     let Some(bins) = hammon_fit_bins(case, &grid, part, tol) else { continue };
                     rows(case, slot, Hemisphere::R, channel, &mut |i| Value { energy: bins[i], stderr: 0.0 }, &mut out);
                 }
