@@ -380,13 +380,17 @@ pub struct CompareConfig {
     pub paths: Option<u64>,
 }
 
-/// A precision target: a case stops at the first round of chunks after which the relative
-/// standard error of every nonzero albedo of order slots `0..=orders` (both hemispheres,
-/// channel 0) is at most `target_rel_stderr`; `paths` is then the maximum.
+/// A precision target: a case stops at the first round of chunks after which every nonzero
+/// albedo of order slots `0..=orders` (both hemispheres, channel 0) has a standard error of at
+/// most `target_stderr` and a relative standard error of at most `target_rel_stderr` (each
+/// when given; at least one must be); `paths` is then the maximum.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct PrecisionConfig {
-    pub target_rel_stderr: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_rel_stderr: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_stderr: Option<f64>,
     #[serde(default = "default_precision_orders")]
     pub orders: usize,
 }
@@ -398,7 +402,25 @@ fn default_precision_orders() -> usize {
 impl PrecisionConfig {
     /// Whether a case's measurement meets the target.
     pub fn is_met(&self, result: &crate::run::CaseResult) -> bool {
-        result.relative_stderrs(self.orders).iter().all(|&r| r <= self.target_rel_stderr)
+        result.albedo_stderrs(self.orders).iter().all(|&(mean, se)| {
+            self.target_stderr.is_none_or(|t| se <= t) && self.target_rel_stderr.is_none_or(|t| se <= t * mean)
+        })
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        if self.target_rel_stderr.is_none() && self.target_stderr.is_none() {
+            return Err(invalid("precision", "{}", "a `target_rel_stderr` or a `target_stderr` (or both)"));
+        }
+        let targets =
+            [("precision.target_rel_stderr", self.target_rel_stderr), ("precision.target_stderr", self.target_stderr)];
+        for (field, target) in targets {
+            if let Some(t) = target {
+                if !(t.is_finite() && t > 0.0) {
+                    return Err(invalid(field, t, "a standard error > 0"));
+                }
+            }
+        }
+        Ok(())
     }
 }
 
@@ -417,7 +439,7 @@ pub enum ConfigError {
     Invalid { field: String, value: String, allowed: String },
 }
 
-fn invalid(field: impl Into<String>, value: impl fmt::Display, allowed: impl Into<String>) -> ConfigError {
+pub(crate) fn invalid(field: impl Into<String>, value: impl fmt::Display, allowed: impl Into<String>) -> ConfigError {
     ConfigError::Invalid { field: field.into(), value: value.to_string(), allowed: allowed.into() }
 }
 
@@ -517,13 +539,7 @@ impl Config {
             return Err(invalid("detector.max_order", 0, "an order >= 1, or leave it out to keep every order"));
         }
         if let Some(p) = &self.precision {
-            if !(p.target_rel_stderr.is_finite() && p.target_rel_stderr > 0.0) {
-                return Err(invalid(
-                    "precision.target_rel_stderr",
-                    p.target_rel_stderr,
-                    "a relative standard error > 0",
-                ));
-            }
+            p.validate()?;
         }
         if let Some(c) = &self.compare {
             for m in &c.models {

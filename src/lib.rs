@@ -11,6 +11,7 @@ pub mod checkpoint;
 pub mod compare;
 pub mod config;
 pub mod detector;
+pub mod lut;
 pub mod models;
 pub mod output;
 pub mod quadrature;

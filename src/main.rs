@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand};
 use smithwalk::checkpoint::{self, Checkpointer};
 use smithwalk::compare::Model;
 use smithwalk::config::Config;
+use smithwalk::lut::LutConfig;
 use smithwalk::output::{EnergyBalance, prepare_dir};
 use smithwalk::run::{Estimator, Shard};
 use smithwalk::shard::write_shard;
@@ -78,6 +79,21 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
+    },
+    /// Measure energy-compensation tables (directional albedo per order, its average) from a
+    /// table config; writes lut.csv, lut_avg.csv, lut.exr, lut.h, lut.rs and lut.json.
+    Lut {
+        /// The table configuration (TOML; see configs/lut-*.toml).
+        config: PathBuf,
+        /// Photons per cell (overrides `paths`).
+        #[arg(long)]
+        paths: Option<u64>,
+        /// Worker threads (default: all cores). Outputs do not depend on it.
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Output directory (default: out/<config name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Measure the walk's throughput on the reference cases (paths/s per core, ns per
     /// facet interaction, and the 1 -> 2 thread scaling).
@@ -147,9 +163,7 @@ fn run(
             shard.count
         );
     }
-    let out = out.unwrap_or_else(|| {
-        PathBuf::from("out").join(config_path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()))
-    });
+    let out = out.unwrap_or_else(|| default_out(&config_path));
     prepare_dir(&out)?;
     let states = if resume { checkpoint::load(&out, &config, shard)? } else { None };
     let mut checkpoints = Checkpointer::new(&out, Duration::from_secs_f64(checkpoint_seconds), &config, shard)?;
@@ -178,6 +192,36 @@ fn run(
         let models =
             c.models.iter().map(|m| Model::parse(m).map_err(anyhow::Error::msg)).collect::<Result<Vec<_>>>()?;
         print!("{}", smithwalk::compare::compare(&out, &models, c.paths, threads)?);
+    }
+    Ok(())
+}
+
+fn default_out(config_path: &Path) -> PathBuf {
+    PathBuf::from("out").join(config_path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()))
+}
+
+fn lut(config_path: &Path, paths: Option<u64>, threads: Option<usize>, out: Option<PathBuf>) -> Result<()> {
+    let mut config = LutConfig::load(config_path)?;
+    if let Some(p) = paths {
+        config.paths = p;
+    }
+    config.validate()?;
+    if threads == Some(0) {
+        bail!("`--threads` = 0 is not allowed: at least 1 thread");
+    }
+    let out = out.unwrap_or_else(|| default_out(config_path));
+    prepare_dir(&out)?;
+    let lut = smithwalk::lut::build(&config, threads, true)?;
+    let written = smithwalk::lut::write(&lut, &out)?;
+    let worst = lut.tables.iter().flat_map(|t| t.e_stderr.iter()).fold(0.0_f64, |a, &b| a.max(b));
+    println!(
+        "{} cells, {} photons in {:.2} s; largest standard error {worst:.2e}",
+        lut.photons.len(),
+        lut.photons.iter().sum::<u64>(),
+        lut.wall_seconds
+    );
+    for path in written {
+        println!("wrote {}", path.display());
     }
     Ok(())
 }
@@ -255,6 +299,7 @@ fn main() -> ExitCode {
         Command::Compare { run_dir, models, paths, threads } => {
             smithwalk::compare::compare(&run_dir, &models, paths, threads).map(|report| print!("{report}"))
         }
+        Command::Lut { config, paths, threads, out } => lut(&config, paths, threads, out),
         Command::Bench { paths } => bench(paths),
     };
     match result {

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use crate::cases::Case;
 use crate::config::{FresnelKind, IncidentSide, MaterialConfig, NdfKind, NormalsKind, SmithKind};
 use crate::detector::{Grid, Hemisphere};
-use crate::quadrature::integrate_2d;
+use crate::quadrature::{gauss_legendre, integrate_2d};
 
 /// The outgoing direction of a bin coordinate: `|cos theta| = u`, azimuth `phi` from the
 /// incident azimuth `phi_i`, in the hemisphere of `sign`.
@@ -71,32 +71,6 @@ fn exit_lobe<N: Ndf>(ndf: &N, wi: DVec3, wo: DVec3, visible: &[(DVec3, f64)], g:
     }
     let escape = (1.0 + ndf.lambda(wi)) * single::g2_reflection(ndf, wi, wo);
     escape * visible.iter().map(|&(m, w)| w * g(wi.dot(m), wo.dot(m).max(0.0))).sum::<f64>()
-}
-
-/// Gauss–Legendre nodes and weights on [a, b] (Newton iteration on the Legendre polynomial).
-fn gauss_legendre(n: usize, a: f64, b: f64) -> Vec<(f64, f64)> {
-    (0..n)
-        .map(|i| {
-            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            let mut dp = 1.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                let step = p1 / dp;
-                x -= step;
-                if step.abs() < 1e-15 {
-                    break;
-                }
-            }
-            let w = 2.0 / ((1.0 - x * x) * dp * dp);
-            (0.5 * (a + b) + 0.5 * (b - a) * x, 0.5 * (b - a) * w)
-        })
-        .collect()
 }
 
 /// A quadrature rule for GGX visible normals seen from `wi`: in the stretched configuration

@@ -16,7 +16,7 @@ use crate::run::CaseResult;
 const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
 
 /// The serde name of a config enum value (`"ggx"`, `"hammon-rejection"`, ...).
-fn name<T: Serialize>(value: &T) -> String {
+pub(crate) fn name<T: Serialize>(value: &T) -> String {
     match serde_json::to_value(value) {
         Ok(serde_json::Value::String(s)) => s,
         other => format!("{other:?}"),

@@ -79,6 +79,32 @@ pub fn integrate_2d(f: impl Fn(f64, f64) -> f64, x: (f64, f64), y: (f64, f64), a
     integrate(|xv| integrate(|yv| f(xv, yv), y.0, y.1, inner_tol).0, x.0, x.1, abs_tol)
 }
 
+/// Gauss–Legendre nodes and weights on [a, b] (Newton iteration on the Legendre polynomial).
+pub fn gauss_legendre(n: usize, a: f64, b: f64) -> Vec<(f64, f64)> {
+    (0..n)
+        .map(|i| {
+            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 1.0;
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let step = p1 / dp;
+                x -= step;
+                if step.abs() < 1e-15 {
+                    break;
+                }
+            }
+            let w = 2.0 / ((1.0 - x * x) * dp * dp);
+            (0.5 * (a + b) + 0.5 * (b - a) * x, 0.5 * (b - a) * w)
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::cases::Case;
 use crate::config::{Config, FresnelKind, MaterialConfig, NdfKind, NormalsKind, SmithKind};
-use crate::detector::{Detector, Grid};
+use crate::detector::{Detector, Grid, Hemisphere};
 
 /// Photons per chunk: the unit of work and of random streams. Part of the output's identity:
 /// changing it changes which random numbers each photon uses.
@@ -141,10 +141,25 @@ impl CaseResult {
         }
     }
 
-    /// Relative standard errors of the albedos of order slots `0..=slots` in both hemispheres
+    /// The albedo of order slot `slot` into `hemisphere` (channel 0) and its standard error;
+    /// zero for slots no light reached.
+    pub fn albedo(&self, slot: usize, hemisphere: Hemisphere) -> (f64, f64) {
+        fn of<const C: usize>(d: &Detector<C>, slot: usize, hemisphere: Hemisphere) -> (f64, f64) {
+            d.tallies
+                .orders
+                .get(slot)
+                .map_or((0.0, 0.0), |o| o.albedo[hemisphere as usize].mean_and_stderr(d.tallies.photons, 0))
+        }
+        match self {
+            CaseResult::Mono(d) => of(d, slot, hemisphere),
+            CaseResult::Rgb(d) => of(d, slot, hemisphere),
+        }
+    }
+
+    /// The albedos and standard errors of order slots `0..=slots` in both hemispheres
     /// (channel 0), leaving out those with no light.
-    pub fn relative_stderrs(&self, slots: usize) -> Vec<f64> {
-        fn of<const C: usize>(d: &Detector<C>, slots: usize) -> Vec<f64> {
+    pub fn albedo_stderrs(&self, slots: usize) -> Vec<(f64, f64)> {
+        fn of<const C: usize>(d: &Detector<C>, slots: usize) -> Vec<(f64, f64)> {
             let n = d.tallies.photons;
             d.tallies
                 .orders
@@ -153,7 +168,6 @@ impl CaseResult {
                 .flat_map(|o| o.albedo.iter())
                 .map(|t| t.mean_and_stderr(n, 0))
                 .filter(|(mean, _)| *mean > 0.0)
-                .map(|(mean, se)| se / mean)
                 .collect()
         }
         match self {
