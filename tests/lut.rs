@@ -243,7 +243,7 @@ fn c_header_rust_source_and_exr_hold_the_csv_values() {
         .find(|l| l.attributes.layer_name.as_ref().is_some_and(|n| n == "E"))
         .expect("layer E");
     assert_eq!((layer.size.0, layer.size.1), (3, 4));
-    let channel = layer.channel_data.list.iter().find(|c| c.name == "inside_T_all").expect("channel");
+    let channel = layer.channel_data.list.iter().find(|c| c.name == *"inside_T_all").expect("channel");
     let values: Vec<f32> = channel.sample_data.values_as_f32().collect();
     assert_eq!(values, expected);
 }
