@@ -12,7 +12,7 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
+use anyhow::Result;
 use microsurface::wang::Shadowing;
 
 use crate::config::Config;
@@ -20,6 +20,7 @@ use crate::detector::{Grid, Hemisphere};
 use crate::models::{HammonFitPart, hammon_fit_bins, single_scattering_bins};
 use crate::output::{case_fields, write_atomically};
 use crate::run::{Estimator, Shard};
+use crate::rundir::{Table, read_config};
 use crate::stats::{Cell, ChiSquare};
 use crate::{RunOptions, Simulation};
 
@@ -70,41 +71,18 @@ type BinKey = (String, String, String, String, String, String);
 /// Key of one lobe: case, order, hemisphere, channel.
 type LobeKey = (String, String, String, String);
 
-/// A CSV table of a run directory, read whole, with its columns found by name.
-struct Table {
-    path: std::path::PathBuf,
-    headers: csv::StringRecord,
-    records: Vec<csv::StringRecord>,
-}
-
-impl Table {
-    fn read(path: &Path) -> Result<Self> {
-        let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
-        let headers = reader.headers()?.clone();
-        let records = reader.records().collect::<Result<Vec<_>, _>>()?;
-        Ok(Self { path: path.to_path_buf(), headers, records })
-    }
-
-    fn column(&self, name: &str) -> Result<usize> {
-        self.headers
-            .iter()
-            .position(|h| h == name)
-            .with_context(|| format!("{}: no column {name}", self.path.display()))
-    }
-
-    /// The lobe key of every record: case, order, hemisphere, channel ("" for mono runs).
-    fn lobe_keys(&self) -> Result<Vec<LobeKey>> {
-        let (case, order, hemi) = (self.column("case")?, self.column("order")?, self.column("hemisphere")?);
-        let channel = self.headers.iter().position(|h| h == "channel");
-        Ok(self
-            .records
-            .iter()
-            .map(|r| {
-                let channel = channel.map_or(String::new(), |c| r[c].to_string());
-                (r[case].to_string(), r[order].to_string(), r[hemi].to_string(), channel)
-            })
-            .collect())
-    }
+/// The lobe key of every record: case, order, hemisphere, channel ("" for mono runs).
+fn lobe_keys(table: &Table) -> Result<Vec<LobeKey>> {
+    let (case, order, hemi) = (table.column("case")?, table.column("order")?, table.column("hemisphere")?);
+    let channel = table.headers.iter().position(|h| h == "channel");
+    Ok(table
+        .records
+        .iter()
+        .map(|r| {
+            let channel = channel.map_or(String::new(), |c| r[c].to_string());
+            (r[case].to_string(), r[order].to_string(), r[hemi].to_string(), channel)
+        })
+        .collect())
 }
 
 /// The measured bins of a run directory's `lobes.csv`.
@@ -113,7 +91,7 @@ fn read_lobes(path: &Path) -> Result<HashMap<BinKey, Value>> {
     let (cos_lo, phi_lo) = (table.column("cos_lo")?, table.column("phi_lo_deg")?);
     let (energy, se) = (table.column("energy")?, table.column("energy_stderr")?);
     let mut out = HashMap::new();
-    for ((case, order, hemi, channel), r) in table.lobe_keys()?.into_iter().zip(&table.records) {
+    for ((case, order, hemi, channel), r) in lobe_keys(&table)?.into_iter().zip(&table.records) {
         let key = (case, order, hemi, channel, r[cos_lo].to_string(), r[phi_lo].to_string());
         out.insert(key, Value { energy: r[energy].parse()?, stderr: r[se].parse()? });
     }
@@ -125,7 +103,7 @@ fn read_summary(path: &Path) -> Result<HashMap<LobeKey, Value>> {
     let table = Table::read(path)?;
     let (albedo, se) = (table.column("albedo")?, table.column("albedo_stderr")?);
     let mut out = HashMap::new();
-    for (key, r) in table.lobe_keys()?.into_iter().zip(&table.records) {
+    for (key, r) in lobe_keys(&table)?.into_iter().zip(&table.records) {
         out.insert(key, Value { energy: r[albedo].parse()?, stderr: r[se].parse()? });
     }
     Ok(out)
@@ -353,13 +331,7 @@ fn compare_lobe(
 /// Runs the comparison of `run_dir` with `models` and writes `models.csv` and `compare.csv`
 /// into it; returns the human-readable report.
 pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Option<usize>) -> Result<String> {
-    let run_json = run_dir.join("run.json");
-    let text = std::fs::read_to_string(&run_json).with_context(|| format!("cannot read {}", run_json.display()))?;
-    let json: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", run_json.display()))?;
-    let Some(config_json) = json.get("config") else { bail!("{}: no `config`", run_json.display()) };
-    let mut config: Config = serde_json::from_value(config_json.clone()).context("the run's config")?;
-    config.validate()?;
+    let mut config = read_config(run_dir)?;
     let measured_photons = config.paths;
     let measured = read_lobes(&run_dir.join("lobes.csv"))?;
     let summary = read_summary(&run_dir.join("summary.csv"))?;

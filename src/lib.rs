@@ -12,10 +12,12 @@ pub mod compare;
 pub mod config;
 pub mod detector;
 pub mod lut;
+pub mod merl;
 pub mod models;
 pub mod output;
 pub mod quadrature;
 pub mod run;
+pub mod rundir;
 pub mod shard;
 pub mod stats;
 

@@ -80,6 +80,15 @@ enum Command {
         #[arg(long)]
         threads: Option<usize>,
     },
+    /// Export an isotropic reflective sweep (one surface and material, many theta_deg) as a
+    /// MERL .binary BRDF file.
+    Merl {
+        /// The run's output directory.
+        run_dir: PathBuf,
+        /// The MERL file to write (default: RUN_DIR/brdf.binary).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Measure energy-compensation tables (directional albedo per order, its average) from a
     /// table config; writes lut.csv, lut_avg.csv, lut.exr, lut.h, lut.rs and lut.json.
     Lut {
@@ -300,6 +309,10 @@ fn main() -> ExitCode {
             smithwalk::compare::compare(&run_dir, &models, paths, threads).map(|report| print!("{report}"))
         }
         Command::Lut { config, paths, threads, out } => lut(&config, paths, threads, out),
+        Command::Merl { run_dir, out } => {
+            let out = out.unwrap_or_else(|| run_dir.join("brdf.binary"));
+            smithwalk::merl::export(&run_dir, &out).map(|p| println!("wrote {}", p.display()))
+        }
         Command::Bench { paths } => bench(paths),
     };
     match result {

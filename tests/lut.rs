@@ -237,11 +237,8 @@ fn c_header_rust_source_and_exr_hold_the_csv_values() {
 
     // OpenEXR: layer E, channel inside_T_all, rows eta * n_alpha + alpha, columns mu.
     let image = exr::prelude::read_all_flat_layers_from_file(dir.path().join("lut.exr")).unwrap();
-    let layer = image
-        .layer_data
-        .iter()
-        .find(|l| l.attributes.layer_name.as_ref().is_some_and(|n| n == "E"))
-        .expect("layer E");
+    let layer =
+        image.layer_data.iter().find(|l| l.attributes.layer_name.as_ref().is_some_and(|n| n == "E")).expect("layer E");
     assert_eq!((layer.size.0, layer.size.1), (3, 4));
     let channel = layer.channel_data.list.iter().find(|c| c.name == *"inside_T_all").expect("channel");
     let values: Vec<f32> = channel.sample_data.values_as_f32().collect();
