@@ -15,6 +15,7 @@ pub mod lut;
 pub mod merl;
 pub mod models;
 pub mod output;
+pub mod plot;
 pub mod quadrature;
 pub mod run;
 pub mod rundir;

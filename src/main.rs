@@ -80,6 +80,12 @@ enum Command {
         #[arg(long)]
         threads: Option<usize>,
     },
+    /// Draw a run's lobes (plane of incidence per order with the models of models.csv, polar
+    /// heat maps) and per-order albedos as PNG files, with an index.html, into the run directory.
+    Plot {
+        /// The run's output directory.
+        run_dir: PathBuf,
+    },
     /// Export an isotropic reflective sweep (one surface and material, many theta_deg) as a
     /// MERL .binary BRDF file.
     Merl {
@@ -309,6 +315,8 @@ fn main() -> ExitCode {
             smithwalk::compare::compare(&run_dir, &models, paths, threads).map(|report| print!("{report}"))
         }
         Command::Lut { config, paths, threads, out } => lut(&config, paths, threads, out),
+        Command::Plot { run_dir } => smithwalk::plot::plot(&run_dir)
+            .map(|written| println!("wrote {} files; open {}", written.len(), run_dir.join("index.html").display())),
         Command::Merl { run_dir, out } => {
             let out = out.unwrap_or_else(|| run_dir.join("brdf.binary"));
             smithwalk::merl::export(&run_dir, &out).map(|p| println!("wrote {}", p.display()))
