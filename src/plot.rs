@@ -28,6 +28,8 @@ use crate::output::{case_fields, write_atomically};
 use crate::rundir::{BinValue, Lobes, RunDir, SummaryRow};
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+/// Points of a curve with error bars: (x, y, standard error).
+type Points = Vec<(f64, f64, f64)>;
 
 const FONT: &str = "sans-serif";
 /// Line colours of the models, in `models.csv` order (the measurement is black).
@@ -82,7 +84,7 @@ fn slot_label(run: &RunDir, slot: usize) -> String {
 
 /// The lobe f |cos theta_o| in the plane of incidence: (signed theta_o in degrees, value,
 /// standard error), light's side negative, mirror side positive.
-fn plane_of_incidence(run: &RunDir, bins: &[BinValue]) -> Vec<(f64, f64, f64)> {
+fn plane_of_incidence(run: &RunDir, bins: &[BinValue]) -> Points {
     let g = run.grid;
     let dphi = std::f64::consts::TAU / g.phi_bins as f64;
     let dcos = 1.0 / g.cos_bins as f64;
@@ -141,7 +143,7 @@ fn lobe_figure(
                 let Some(bins) = measured.get(case.index, slot, hemisphere, 0) else { continue };
                 let points = plane_of_incidence(run, bins);
                 // Colours follow the model, not its position among the models of this panel.
-                let lines: Vec<(RGBColor, &String, Vec<(f64, f64, f64)>)> = models
+                let lines: Vec<(RGBColor, &String, Points)> = models
                     .iter()
                     .enumerate()
                     .filter_map(|(k, (name, lobes))| {
@@ -254,7 +256,7 @@ fn albedo_figure(
     x_of: impl Fn(&Case) -> f64,
     key_of: impl Fn(&Case) -> String,
 ) -> Result<Option<Vec<u8>>> {
-    let mut panels: BTreeMap<(String, String), BTreeMap<usize, Vec<(f64, f64, f64)>>> = BTreeMap::new();
+    let mut panels: BTreeMap<(String, String), BTreeMap<usize, Points>> = BTreeMap::new();
     for row in summary.iter().filter(|r| matches!(r.hemisphere.as_str(), "R" | "T")) {
         if row.channel.as_deref().is_some_and(|c| c != "r") {
             continue;
