@@ -526,30 +526,36 @@ fn provenance(lut: &Lut) -> String {
     )
 }
 
+/// Every array a source file carries, in order: the nodes, then per quantity E, its
+/// standard error, E_avg and its standard error; each with its name and dimensions.
+fn source_arrays(lut: &Lut) -> Vec<(String, &[f64], Vec<usize>)> {
+    let (e_dims, avg_dims) = dims(lut);
+    let mut arrays = vec![("mu".to_string(), lut.mu.as_slice(), vec![lut.mu.len()])];
+    arrays.push(("alpha".to_string(), &lut.alpha, vec![lut.alpha.len()]));
+    if !lut.eta.is_empty() {
+        arrays.push(("eta".to_string(), &lut.eta, vec![lut.eta.len()]));
+    }
+    for t in &lut.tables {
+        let q = &t.quantity.name;
+        arrays.push((format!("E_{q}"), &t.e, e_dims.clone()));
+        arrays.push((format!("E_{q}_stderr"), &t.e_stderr, e_dims.clone()));
+        arrays.push((format!("E_avg_{q}"), &t.avg, avg_dims.clone()));
+        arrays.push((format!("E_avg_{q}_stderr"), &t.avg_stderr, avg_dims.clone()));
+    }
+    arrays
+}
+
 /// `lut.h`: a C header with the node arrays and, per quantity, `smithwalk_E_<q>`,
 /// `smithwalk_E_<q>_stderr`, `smithwalk_E_avg_<q>` and `smithwalk_E_avg_<q>_stderr`.
 pub fn c_header(lut: &Lut) -> Vec<u8> {
     let mut out = String::new();
     let _ = writeln!(out, "/* {} */", provenance(lut));
     out.push_str("#ifndef SMITHWALK_LUT_H\n#define SMITHWALK_LUT_H\n\n");
-    let (e_dims, avg_dims) = dims(lut);
-    let array = |out: &mut String, name: &str, values: &[f64], dims: &[usize]| {
+    for (name, values, dims) in source_arrays(lut) {
         let shape: String = dims.iter().map(|d| format!("[{d}]")).collect();
         let _ = writeln!(out, "static const float smithwalk_{name}{shape} =");
-        nested(out, values, dims, "f", 0);
+        nested(&mut out, values, &dims, "f", 0);
         out.push_str(";\n\n");
-    };
-    array(&mut out, "mu", &lut.mu, &[lut.mu.len()]);
-    array(&mut out, "alpha", &lut.alpha, &[lut.alpha.len()]);
-    if !lut.eta.is_empty() {
-        array(&mut out, "eta", &lut.eta, &[lut.eta.len()]);
-    }
-    for t in &lut.tables {
-        let q = &t.quantity.name;
-        array(&mut out, &format!("E_{q}"), &t.e, &e_dims);
-        array(&mut out, &format!("E_{q}_stderr"), &t.e_stderr, &e_dims);
-        array(&mut out, &format!("E_avg_{q}"), &t.avg, &avg_dims);
-        array(&mut out, &format!("E_avg_{q}_stderr"), &t.avg_stderr, &avg_dims);
     }
     out.push_str("#endif /* SMITHWALK_LUT_H */\n");
     out.into_bytes()
@@ -562,29 +568,13 @@ pub fn rust_source(lut: &Lut) -> Vec<u8> {
     for line in provenance(lut).lines() {
         let _ = writeln!(out, "// {line}");
     }
-    let (e_dims, avg_dims) = dims(lut);
-    let array = |out: &mut String, name: &str, values: &[f64], dims: &[usize]| {
+    for (name, values, dims) in source_arrays(lut) {
         let ty = dims.iter().rev().fold("f32".to_string(), |inner, d| format!("[{inner}; {d}]"));
         let _ = writeln!(out, "#[rustfmt::skip]\npub const {}: {ty} =", name.to_uppercase());
-        let text = {
-            let mut s = String::new();
-            nested(&mut s, values, dims, "", 0);
-            s.replace('{', "[").replace('}', "]")
-        };
-        out.push_str(&text);
+        let mut text = String::new();
+        nested(&mut text, values, &dims, "", 0);
+        out.push_str(&text.replace('{', "[").replace('}', "]"));
         out.push_str(";\n\n");
-    };
-    array(&mut out, "mu", &lut.mu, &[lut.mu.len()]);
-    array(&mut out, "alpha", &lut.alpha, &[lut.alpha.len()]);
-    if !lut.eta.is_empty() {
-        array(&mut out, "eta", &lut.eta, &[lut.eta.len()]);
-    }
-    for t in &lut.tables {
-        let q = &t.quantity.name;
-        array(&mut out, &format!("E_{q}"), &t.e, &e_dims);
-        array(&mut out, &format!("E_{q}_stderr"), &t.e_stderr, &e_dims);
-        array(&mut out, &format!("E_avg_{q}"), &t.avg, &avg_dims);
-        array(&mut out, &format!("E_avg_{q}_stderr"), &t.avg_stderr, &avg_dims);
     }
     out.into_bytes()
 }
