@@ -384,9 +384,17 @@ fn assemble(config: &LutConfig, sim: &Simulation) -> Lut {
     Lut { config: config.clone(), mu, alpha, eta, tables, photons, wall_seconds: sim.wall_seconds }
 }
 
-/// The coordinates of cell `[slice][a][m]` as CSV fields: eta (empty without), alpha, mu.
-fn eta_field(lut: &Lut, slice: usize) -> String {
-    lut.eta.get(slice).map_or(String::new(), |e| e.to_string())
+/// The leading CSV fields of a quantity at eta slice `slice` (eta empty for tables without
+/// eta) and roughness `alpha`.
+fn quantity_fields(lut: &Lut, q: &Quantity, slice: usize, alpha: f64) -> Vec<String> {
+    vec![
+        q.name.clone(),
+        name(&q.side),
+        format!("{:?}", q.hemisphere),
+        q.order.clone(),
+        lut.eta.get(slice).map_or(String::new(), |e| e.to_string()),
+        alpha.to_string(),
+    ]
 }
 
 /// `lut.csv`: one row per quantity and cell, with the standard error and photon count.
@@ -400,18 +408,10 @@ pub fn csv_table(lut: &Lut) -> Result<Vec<u8>> {
             for (a, alpha) in lut.alpha.iter().enumerate() {
                 for (m, mu) in lut.mu.iter().enumerate() {
                     let i = (slice * lut.alpha.len() + a) * n_mu + m;
-                    w.write_record([
-                        q.name.clone(),
-                        side_name(q.side).to_string(),
-                        format!("{:?}", q.hemisphere),
-                        q.order.clone(),
-                        eta_field(lut, slice),
-                        alpha.to_string(),
-                        mu.to_string(),
-                        t.e[i].to_string(),
-                        t.e_stderr[i].to_string(),
-                        lut.photons[i].to_string(),
-                    ])?;
+                    let mut row = quantity_fields(lut, q, slice, *alpha);
+                    row.extend([mu.to_string(), t.e[i].to_string(), t.e_stderr[i].to_string()]);
+                    row.push(lut.photons[i].to_string());
+                    w.write_record(&row)?;
                 }
             }
         }
@@ -428,27 +428,13 @@ pub fn csv_avg(lut: &Lut) -> Result<Vec<u8>> {
         for slice in 0..lut.slices() {
             for (a, alpha) in lut.alpha.iter().enumerate() {
                 let i = slice * lut.alpha.len() + a;
-                w.write_record([
-                    q.name.clone(),
-                    side_name(q.side).to_string(),
-                    format!("{:?}", q.hemisphere),
-                    q.order.clone(),
-                    eta_field(lut, slice),
-                    alpha.to_string(),
-                    t.avg[i].to_string(),
-                    t.avg_stderr[i].to_string(),
-                ])?;
+                let mut row = quantity_fields(lut, q, slice, *alpha);
+                row.extend([t.avg[i].to_string(), t.avg_stderr[i].to_string()]);
+                w.write_record(&row)?;
             }
         }
     }
     Ok(w.into_inner()?)
-}
-
-fn side_name(side: IncidentSide) -> &'static str {
-    match side {
-        IncidentSide::Outside => "outside",
-        IncidentSide::Inside => "inside",
-    }
 }
 
 /// `lut.exr`: two layers. `E` is n_mu wide and n_eta * n_alpha high (row = eta * n_alpha +

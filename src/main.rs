@@ -164,9 +164,7 @@ fn run(
         config.seed = s;
     }
     config.validate()?;
-    if threads == Some(0) {
-        bail!("`--threads` = 0 is not allowed: at least 1 thread");
-    }
+    check_threads(threads)?;
     if !(checkpoint_seconds.is_finite() && checkpoint_seconds > 0.0) {
         bail!("`--checkpoint-seconds` = {checkpoint_seconds} is not allowed: a positive number of seconds");
     }
@@ -211,6 +209,14 @@ fn run(
     Ok(())
 }
 
+/// `--threads`, when given, must be at least 1.
+fn check_threads(threads: Option<usize>) -> Result<()> {
+    if threads == Some(0) {
+        bail!("`--threads` = 0 is not allowed: at least 1 thread");
+    }
+    Ok(())
+}
+
 fn default_out(config_path: &Path) -> PathBuf {
     PathBuf::from("out").join(config_path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()))
 }
@@ -221,9 +227,7 @@ fn lut(config_path: &Path, paths: Option<u64>, threads: Option<usize>, out: Opti
         config.paths = p;
     }
     config.validate()?;
-    if threads == Some(0) {
-        bail!("`--threads` = 0 is not allowed: at least 1 thread");
-    }
+    check_threads(threads)?;
     let out = out.unwrap_or_else(|| default_out(config_path));
     prepare_dir(&out)?;
     let lut = smithwalk::lut::build(&config, threads, true)?;

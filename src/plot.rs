@@ -100,8 +100,9 @@ fn plane_of_incidence(run: &RunDir, bins: &[BinValue]) -> Points {
     points
 }
 
-/// Cases that differ only in the incident polar angle, keyed by their other fields.
-fn groups(cases: &[Case]) -> Vec<(String, Vec<&Case>)> {
+/// Cases that differ only in the incident polar angle, in order of their first case, each
+/// sorted by the incident angle.
+fn groups(cases: &[Case]) -> Vec<Vec<&Case>> {
     let mut map: BTreeMap<Vec<String>, Vec<&Case>> = BTreeMap::new();
     for case in cases {
         let mut key = case_fields(case);
@@ -109,11 +110,10 @@ fn groups(cases: &[Case]) -> Vec<(String, Vec<&Case>)> {
         key.remove(0); // case index
         map.entry(key).or_default().push(case);
     }
-    let mut out: Vec<(String, Vec<&Case>)> = map.into_values().map(|cases| (String::new(), cases)).collect();
-    out.sort_by_key(|(_, cases)| cases[0].index);
-    for (i, (name, cases)) in out.iter_mut().enumerate() {
+    let mut out: Vec<Vec<&Case>> = map.into_values().collect();
+    out.sort_by_key(|cases| cases[0].index);
+    for cases in &mut out {
         cases.sort_by(|a, b| a.theta_i_deg.total_cmp(&b.theta_i_deg));
-        *name = format!("g{i}");
     }
     out
 }
@@ -375,7 +375,7 @@ pub fn plot(run_dir: &Path) -> Result<Vec<PathBuf>> {
             files.push((name.to_string(), png));
         }
     }
-    for (group, cases) in groups(&run.cases) {
+    for (group, cases) in groups(&run.cases).into_iter().enumerate() {
         let _ = writeln!(html, "<h2>{}</h2>", html_escape(&surface_label(cases[0])));
         html.push_str("<table><tr>");
         for column in crate::output::CASE_COLUMNS {
@@ -398,7 +398,7 @@ pub fn plot(run_dir: &Path) -> Result<Vec<PathBuf>> {
         }
         html.push_str("</table>\n");
         for h in &hemispheres {
-            let name = format!("lobes_{group}_{h}.png");
+            let name = format!("lobes_g{group}_{h}.png");
             files.push((name.clone(), lobe_figure(&run, &cases, h, &measured, &models)?));
             let _ = writeln!(html, "<p><img src=\"{name}\" alt=\"{name}\"></p>");
         }

@@ -39,11 +39,9 @@ impl Merl {
         let theta_h = h.z.clamp(-1.0, 1.0).acos();
         let theta_d = wi.dot(h).clamp(-1.0, 1.0).acos();
         // phi_d: azimuth of wi about h, measured from the plane of h and the normal.
-        let n = DVec3::Z;
-        let t = if theta_h > 1e-9 { (n - h * h.z).normalize() } else { DVec3::X };
         let (x_axis, y_axis) = if theta_h > 1e-9 {
             // x axis: the tangent of h's azimuth pointing away from the normal's projection.
-            let x = -t;
+            let x = (h * h.z - DVec3::Z).normalize();
             (x, h.cross(x))
         } else {
             (DVec3::X, DVec3::Y)
