@@ -17,10 +17,12 @@ pub mod models;
 pub mod output;
 pub mod plot;
 pub mod quadrature;
+pub mod rgl;
 pub mod run;
 pub mod rundir;
 pub mod shard;
 pub mod stats;
+pub mod sweep;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;

@@ -95,6 +95,18 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Export an isotropic reflective sweep as an RGL material file (.bsdf, RGB), the format of
+    /// the RGL material database that Mitsuba 3's `measured` plugin renders.
+    Rgl {
+        /// The run's output directory.
+        run_dir: PathBuf,
+        /// The .bsdf file to write (default: RUN_DIR/brdf.bsdf).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Grid points per axis of the half-vector square, per incident angle.
+        #[arg(long, default_value_t = smithwalk::rgl::DEFAULT_RESOLUTION)]
+        resolution: usize,
+    },
     /// Measure energy-compensation tables (directional albedo per order, its average) from a
     /// table config; writes lut.csv, lut_avg.csv, lut.exr, lut.h, lut.rs and lut.json.
     Lut {
@@ -324,6 +336,10 @@ fn main() -> ExitCode {
         Command::Merl { run_dir, out } => {
             let out = out.unwrap_or_else(|| run_dir.join("brdf.binary"));
             smithwalk::merl::export(&run_dir, &out).map(|p| println!("wrote {}", p.display()))
+        }
+        Command::Rgl { run_dir, out, resolution } => {
+            let out = out.unwrap_or_else(|| run_dir.join("brdf.bsdf"));
+            smithwalk::rgl::export(&run_dir, &out, resolution).map(|p| println!("wrote {}", p.display()))
         }
         Command::Bench { paths } => bench(paths),
     };

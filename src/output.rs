@@ -296,6 +296,18 @@ pub fn prepare_dir(dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Writes one file at the path `out` (whose directory is created if need be) atomically.
+pub fn write_file_atomically(out: &Path, bytes: Vec<u8>) -> Result<PathBuf> {
+    let dir = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let name = out.file_name().and_then(|n| n.to_str()).context("--out needs a file name")?;
+    prepare_dir(dir)?;
+    let written = write_atomically(dir, &[(name, bytes)])?;
+    Ok(written.into_iter().next().expect("one file"))
+}
+
 /// Writes all files: every one goes to a temporary file first; only when all are complete are
 /// they renamed into place, so a failure leaves no partial or corrupt output.
 pub fn write_atomically(dir: &Path, files: &[(&str, Vec<u8>)]) -> Result<Vec<PathBuf>> {
