@@ -247,8 +247,8 @@ where
                 Estimator::Walk => w.surface.trace(&w.facet, policy, wi, &mut rng, &mut stack, detector),
                 Estimator::Wang(shadowing) => shadowing.trace(&w.surface.ndf, &w.facet, policy, wi, &mut rng, detector),
                 Estimator::HeitzNee(samples) => {
-                    let (ndf, facet, sink) = (&w.surface.ndf, &w.facet, &mut *detector);
-                    let mut nee = NextEvent { ndf, facet, sink, rng: &mut nee_rng, samples };
+                    let (ndf, normals, facet, sink) = (&w.surface.ndf, w.surface.normals, &w.facet, &mut *detector);
+                    let mut nee = NextEvent { ndf, normals, facet, sink, rng: &mut nee_rng, samples };
                     w.surface.trace(&w.facet, policy, wi, &mut rng, &mut stack, &mut nee)
                 }
             };

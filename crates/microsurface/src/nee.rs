@@ -3,18 +3,18 @@
 //! At the `k`-th hit of a ray (depth `tau`, incident `w = -d`, weight `beta`) the lobe of
 //! order `k` towards `wo` gets `beta p(w -> wo) G1(wo, tau)`: the facet's phase function
 //! times the probability that `wo` escapes from that depth (`e^{-Lambda(wo) tau}` on the ray's
-//! side, or from the other side's depth after a refraction). This is a second, independent
-//! estimator of the same quantity as the escape histogram, order by order.
-
-use std::f64::consts::PI;
+//! side, or from the other side's depth after a refraction). [`contribution`] is this point
+//! evaluation; [`NextEvent`] integrates it over the detector's bins with directions drawn
+//! from the phase function itself. Either way it is a second estimator of the same quantity as
+//! the escape histogram, order by order: the escape event is replaced by its probability.
 
 use glam::DVec3;
 use rand::Rng;
 
-use crate::facet::{Facet, Side};
+use crate::facet::{Branch, Facet, Interaction, Side};
 use crate::height::other_side_depth;
 use crate::ndf::Ndf;
-use crate::random::open01;
+use crate::normals::Normals;
 use crate::walk::{Loss, Observer};
 
 /// The phase function times the escape probability towards `wo` (pointing away from the
@@ -45,17 +45,43 @@ where
     (phase.map(|p| p * escape), exit_side)
 }
 
-/// An observer that turns every hit of a walk into next-event deposits: `samples` outgoing
-/// directions drawn uniformly on the sphere, each weighted by `4 pi / samples` and deposited
-/// into `sink` at the hit's order, so the sink's bin sums estimate the same bin integrals as
-/// the escape histogram. Escapes of the walk itself are ignored; losses are passed on.
+/// An observer that turns every hit of a walk into next-event deposits into `sink` at the hit's
+/// order, so the sink's bin sums estimate the same bin integrals as the escape histogram.
+///
+/// Each hit draws `samples` outgoing directions from the phase function: a facet normal from
+/// the surface's law of hit normals, then the facet's interaction with every branch kept.
+/// The point evaluation divided by the density of its direction is then the branch weight
+/// times the escape probability, so every deposit is at most the ray's weight. (Directions
+/// drawn uniformly on the sphere would divide by the projected area `A(w)` of the incident
+/// direction, which vanishes as `w` goes below the horizon from the second hit on: unbiased,
+/// but with effectively infinite variance.) Escapes of the walk itself are ignored; losses
+/// are passed on.
 pub struct NextEvent<'a, N, F, O, R> {
     pub ndf: &'a N,
+    pub normals: Normals,
     pub facet: &'a F,
     pub sink: &'a mut O,
     /// The estimator's own random stream, kept across photons.
     pub rng: &'a mut R,
     pub samples: u32,
+}
+
+impl<N: Ndf, F, O, R> NextEvent<'_, N, F, O, R> {
+    /// Deposits `beta * branch weight * P(escape)` of one branch leaving a hit at depth `tau` on
+    /// `side`; a branch heading deeper into its side cannot escape before another hit.
+    fn deposit<const C: usize>(&mut self, order: u32, tau: f64, side: Side, branch: &Branch<C>, beta: &[f64; C])
+    where
+        O: Observer<C>,
+    {
+        let (exit_side, exit_tau) = if branch.crosses { (side.other(), other_side_depth(tau)) } else { (side, tau) };
+        let up = if exit_side == Side::Outside { branch.dir } else { -branch.dir };
+        if up.z.is_nan() || up.z <= 0.0 {
+            return;
+        }
+        let escape = (-self.ndf.lambda(up) * exit_tau).exp() / f64::from(self.samples);
+        let deposit = std::array::from_fn(|i| beta[i] * branch.weight[i] * escape);
+        self.sink.escape(order, exit_side, branch.dir, &deposit);
+    }
 }
 
 impl<N, F, O, R, const C: usize> Observer<C> for NextEvent<'_, N, F, O, R>
@@ -72,15 +98,17 @@ where
     }
 
     fn hit(&mut self, order: u32, tau: f64, side: Side, d: DVec3, weight: &[f64; C]) {
-        let scale = 4.0 * PI / f64::from(self.samples);
+        // The hit normal is drawn in the flipped frame of the ray's side (§4.3), as the walk does.
+        let sign = if side == Side::Outside { 1.0 } else { -1.0 };
         for _ in 0..self.samples {
-            let z = 2.0 * open01(self.rng) - 1.0;
-            let (s, c) = (2.0 * PI * open01(self.rng)).sin_cos();
-            let r = (1.0 - z * z).max(0.0).sqrt();
-            let wo = DVec3::new(r * c, r * s, z);
-            let (value, exit) = contribution(self.ndf, self.facet, tau, side, d, wo, self.rng);
-            let deposit = std::array::from_fn(|i| weight[i] * value[i] * scale);
-            self.sink.escape(order, exit, wo, &deposit);
+            let m = sign * self.normals.sample(self.ndf, sign * d, self.rng);
+            match self.facet.interact(-d, m, side, self.rng) {
+                Interaction::One(b) => self.deposit(order, tau, side, &b, weight),
+                Interaction::Two(a, b) => {
+                    self.deposit(order, tau, side, &a, weight);
+                    self.deposit(order, tau, side, &b, weight);
+                }
+            }
         }
     }
 }
