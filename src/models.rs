@@ -6,7 +6,7 @@ use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
 use microsurface::fresnel;
-use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
+use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, slope_to_normal};
 use microsurface::single;
 use rayon::prelude::*;
 
@@ -93,17 +93,44 @@ fn ggx_visible_rule(ndf: &Ggx, wi: DVec3) -> Vec<(DVec3, f64)> {
     rule
 }
 
+/// A quadrature rule for Beckmann visible normals seen from `wi`: in the stretched frame
+/// aligned with `wi` the slope along it has density `∝ (mu - x) e^{-x^2}` on `x < mu = cot
+/// theta'` and the orthogonal slope `∝ e^{-y^2}`, independently (§3.1); Gauss–Legendre in
+/// both over |slope| < 6 (the Gaussian tail beyond holds e^{-36}), weights normalised to 1.
+/// 96 x 96 nodes: bin energies then move by at most 1.5e-7 against 192 x 192 (measured on four
+/// diffuse and Hammon cases), far below the standard error of a bin at 10^8 photons.
+fn beckmann_visible_rule(ndf: &Beckmann, wi: DVec3) -> Vec<(DVec3, f64)> {
+    const N: usize = 96;
+    const TAIL: f64 = 6.0;
+    let roughness = ndf.roughness();
+    let ws = roughness.stretch(wi);
+    let sin_theta = ws.x.hypot(ws.y);
+    let (mu, cos_phi, sin_phi) = if sin_theta > 0.0 {
+        (ws.z / sin_theta, ws.x / sin_theta, ws.y / sin_theta)
+    } else {
+        (f64::INFINITY, 1.0, 0.0)
+    };
+    // At normal incidence (mu infinite) the factor (mu - x) is constant and drops out.
+    let along = |x: f64| if mu.is_finite() { (mu - x) * (-x * x).exp() } else { (-x * x).exp() };
+    let xs = gauss_legendre(N, -TAIL, mu.min(TAIL));
+    let ys = gauss_legendre(N, -TAIL, TAIL);
+    let mut rule = Vec::with_capacity(N * N);
+    for &(x, wx) in &xs {
+        for &(y, wy) in &ys {
+            let (sx, sy) = (cos_phi * x - sin_phi * y, sin_phi * x + cos_phi * y);
+            rule.push((slope_to_normal(roughness.x * sx, roughness.y * sy), wx * along(x) * wy * (-y * y).exp()));
+        }
+    }
+    let total: f64 = rule.iter().map(|r| r.1).sum();
+    rule.iter_mut().for_each(|r| r.1 /= total);
+    rule
+}
+
 /// Expected order-1 energy per photon in every bin of `hemisphere` (index `cos * phi_bins +
-/// phi`), or `None` where single scattering is not available: Hammon's Smith or normals, light
-/// from inside, or diffuse and Hammon facets on Beckmann (their visible-normal integral uses
-/// the GGX cap rule).
+/// phi`), or `None` where single scattering is not available: Hammon's Smith or normals, or
+/// light from inside.
 pub fn single_scattering_bins(case: &Case, grid: &Grid, hemisphere: Hemisphere, abs_tol: f64) -> Option<Vec<f64>> {
-    let scatters_about_normal = matches!(case.material, MaterialConfig::Diffuse { .. } | MaterialConfig::Hammon { .. });
-    if case.smith != SmithKind::Exact
-        || case.normals != NormalsKind::Vndf
-        || case.side != IncidentSide::Outside
-        || (scatters_about_normal && case.ndf != NdfKind::Ggx)
-    {
+    if case.smith != SmithKind::Exact || case.normals != NormalsKind::Vndf || case.side != IncidentSide::Outside {
         return None;
     }
     let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
@@ -118,9 +145,13 @@ fn bins_for<N: Ndf>(ndf: &N, case: &Case, grid: &Grid, hemisphere: Hemisphere, a
         return vec![0.0; grid.bins()];
     }
     let wi = case.incident_direction();
+    let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
     let visible = match (&case.material, case.ndf) {
         (MaterialConfig::Diffuse { .. } | MaterialConfig::Hammon { .. }, NdfKind::Ggx) => {
-            ggx_visible_rule(&Ggx(Roughness { x: case.alpha_x, y: case.alpha_y }), wi)
+            ggx_visible_rule(&Ggx(roughness), wi)
+        }
+        (MaterialConfig::Diffuse { .. } | MaterialConfig::Hammon { .. }, NdfKind::Beckmann) => {
+            beckmann_visible_rule(&Beckmann(roughness), wi)
         }
         _ => Vec::new(),
     };
