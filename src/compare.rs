@@ -275,18 +275,26 @@ impl Moments {
     }
 }
 
+/// The common mean of a bin under the null hypothesis: the model's value for an exact model
+/// (`n_p = 0`), else the photon-weighted mean of the two Monte Carlo estimates.
+fn null_mean(m: Moments, n_m: u64, p: Moments, n_p: u64) -> f64 {
+    if n_p == 0 { p.mean } else { (m.mean * n_m as f64 + p.mean * n_p as f64) / (n_m + n_p) as f64 }
+}
+
 /// The z value of measured moments `m` (over `n_m` photons) against a model's `p` (over `n_p`
 /// photons, 0 for an exact model). Variances are evaluated at the common mean under the null
 /// hypothesis (the model's value, or the photon-weighted mean of two Monte Carlo estimates),
 /// not at the observed values, which would inflate the statistic in sparse bins.
 fn z_value(m: Moments, n_m: u64, p: Moments, n_p: u64) -> Option<f64> {
-    let mu = if n_p == 0 { p.mean } else { (m.mean * n_m as f64 + p.mean * n_p as f64) / (n_m + n_p) as f64 };
+    let mu = null_mean(m, n_m, p, n_p);
     let var = m.variance_at(mu, n_m) + p.variance_at(mu, n_p);
     (var > 0.0).then(|| (m.mean - p.mean) / var.sqrt())
 }
 
 /// Compares one lobe bin by bin with [`z_value`]; bins in which fewer than 5 photons are
-/// expected (from the larger of the two energies) are pooled into one cell.
+/// expected under the null hypothesis ([`null_mean`]) are pooled into one cell. (Pooling by
+/// either estimate alone would keep exactly the bins where that estimate fluctuated up, and
+/// bias the kept differences.)
 fn compare_lobe(
     measured: &HashMap<BinKey, Value>,
     predictions: &[&Prediction],
@@ -308,7 +316,7 @@ fn compare_lobe(
         albedo_var += p.value.stderr * p.value.stderr;
         let (mm, pm) = (Moments::of(m, photons), Moments::of(p.value, model_photons));
         match z_value(mm, photons, pm, model_photons) {
-            Some(z) if photons as f64 * o.max(e) >= 5.0 => {
+            Some(z) if photons as f64 * null_mean(mm, photons, pm, model_photons) >= 5.0 => {
                 cells.push(Cell { bins: vec![i], observed: o, expected: e, z });
             }
             _ => {
@@ -318,7 +326,7 @@ fn compare_lobe(
             }
         }
     }
-    if photons as f64 * pool_m.mean.max(pool_p.mean) >= 5.0 {
+    if photons as f64 * null_mean(pool_m, photons, pool_p, model_photons) >= 5.0 {
         if let Some(z) = z_value(pool_m, photons, pool_p, model_photons) {
             cells.push(Cell { bins: pool_bins, observed: pool_m.mean, expected: pool_p.mean, z });
         }
