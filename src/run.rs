@@ -5,10 +5,12 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use indicatif::ProgressBar;
+use microsurface::chain;
 use microsurface::facet::{Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Lambertian};
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 use microsurface::nee::NextEvent;
 use microsurface::normals::Normals;
+use microsurface::position_free::DepthProfile;
 use microsurface::smith::Smith;
 use microsurface::walk::{EnergyPolicy, Microsurface};
 use microsurface::wang::Shadowing;
@@ -57,6 +59,9 @@ pub enum Estimator {
     /// Next-event estimation along the walk (Heitz et al. 2016 `eval`, §4.7), with this many
     /// outgoing directions per hit.
     HeitzNee(u32),
+    /// The exact position-free chain (§7.1). It holds for facets that reflect on one side:
+    /// cases whose material transmits are skipped (their photons deposit nothing).
+    PositionFree,
 }
 
 /// What every case of a run shares.
@@ -242,10 +247,17 @@ where
         let mut stack = Vec::new();
         let policy = &w.settings.policy;
         let mut nee_rng = chunk_rng(w.settings.seed ^ NEE_STREAMS, w.case.index, chunk);
+        let mut profile = DepthProfile::default();
         for _ in 0..w.settings.chunk_photons(chunk) {
             let interactions = match w.settings.estimator {
                 Estimator::Walk => w.surface.trace(&w.facet, policy, wi, &mut rng, &mut stack, detector),
-                Estimator::Wang(shadowing) => shadowing.trace(&w.surface.ndf, &w.facet, policy, wi, &mut rng, detector),
+                Estimator::Wang(mut shadowing) => {
+                    chain::trace(&mut shadowing, &w.surface.ndf, &w.facet, policy, wi, &mut rng, detector)
+                }
+                Estimator::PositionFree if w.case.material.transmits() => 0,
+                Estimator::PositionFree => {
+                    chain::trace(&mut profile, &w.surface.ndf, &w.facet, policy, wi, &mut rng, detector)
+                }
                 Estimator::HeitzNee(samples) => {
                     let (ndf, normals, facet, sink) = (&w.surface.ndf, w.surface.normals, &w.facet, &mut *detector);
                     let mut nee = NextEvent { ndf, normals, facet, sink, rng: &mut nee_rng, samples };

@@ -15,17 +15,22 @@
 //! * [`single`]: exact single scattering, the walk's order-1 oracle;
 //! * [`slope`]: closed-form GGX masses of slope-space polygons (exact histogram oracles);
 //! * [`nee`]: next-event estimation, a second estimator of the walk's lobes;
-//! * [`wang`]: the position-free models of Wang et al. 2022 as height-free chains;
+//! * [`chain`]: height-free chains of visible-normal scatterings, with a visibility model;
+//! * [`wang`]: the position-free models of Wang et al. 2022 as chain visibilities;
+//! * [`position_free`]: the exact position-free form (depths integrated out), the walk's
+//!   height-free twin for one-sided facets;
 //! * [`random`], [`roots`]: variates and the root finder behind the inverse-CDF samplers.
 //!
 //! Everything here is pure physics: no I/O, no threads, no binning.
 
+pub mod chain;
 pub mod facet;
 pub mod fresnel;
 pub mod height;
 pub mod ndf;
 pub mod nee;
 pub mod normals;
+pub mod position_free;
 pub mod random;
 pub mod roots;
 pub mod single;

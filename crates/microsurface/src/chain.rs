@@ -1,0 +1,97 @@
+//! Height-free chains of visible-normal scatterings (THEORY.md §6.5, §7.1): the position-free
+//! models of the walk's lobes.
+//!
+//! A chain follows one path of directions `d_0, d_1, ...` drawn exactly as the walk draws them
+//! (visible normals, the facet's interaction), but without heights: what escapes after each
+//! vertex is decided by a [`Visibility`] model. At vertex `j`, a direction pointing away from
+//! the surface on its side lets the model's fraction of the chain's weight escape at order
+//! `j`; the rest continues. Two-branch facets always choose one branch at random (no
+//! splitting); weights below the policy's threshold play Russian roulette as in the walk.
+
+use glam::DVec3;
+use rand::Rng;
+
+use crate::facet::{Facet, Interaction, Side};
+use crate::ndf::Ndf;
+use crate::random::open01;
+use crate::smith::Smith;
+use crate::walk::{EnergyPolicy, Loss, Observer, RUNAWAY_ORDER, choose, roulette};
+
+/// What escapes after each vertex of a chain: the alternatives are Wang et al.'s local models
+/// ([`crate::wang::Shadowing`]) and the exact depth profile ([`crate::position_free`]).
+pub trait Visibility {
+    /// Starts a photon that enters along a direction of depth rate `rate` (§2.4).
+    fn enter(&mut self, rate: f64);
+
+    /// The fraction of the chain's weight that escapes when it leaves a vertex along `d`
+    /// (unit, in the frame of the side it leaves into), having arrived along a direction of
+    /// depth rate `rate_in`; `refracted` tells whether the vertex changed side. A direction
+    /// into the surface escapes nothing.
+    fn leave<N: Ndf>(&mut self, ndf: &N, rate_in: f64, d: DVec3, refracted: bool) -> f64;
+}
+
+/// Walks one photon arriving from `wi` (towards the light) through the chain with `visibility`
+/// and deposits the escaping weight of every order into `observer`, like the random walk does.
+/// Returns the number of facet interactions.
+#[allow(clippy::too_many_arguments)]
+pub fn trace<V, N, F, R, O, const C: usize>(
+    visibility: &mut V,
+    ndf: &N,
+    facet: &F,
+    policy: &EnergyPolicy,
+    wi: DVec3,
+    rng: &mut R,
+    observer: &mut O,
+) -> u64
+where
+    V: Visibility,
+    N: Ndf,
+    F: Facet<C>,
+    R: Rng + ?Sized,
+    O: Observer<C>,
+{
+    let mut side = if wi.z >= 0.0 { Side::Outside } else { Side::Inside };
+    let mut d = -wi;
+    let mut weight = [1.0; C];
+    let mut order = 0u32;
+    // The own-side frame (§4.3): inside, directions are flipped.
+    let flip = |v: DVec3, s: Side| if s == Side::Outside { v } else { -v };
+    visibility.enter(Smith::Exact.rate(ndf, flip(d, side)));
+    loop {
+        let d_own = flip(d, side);
+        let rate_in = Smith::Exact.rate(ndf, d_own);
+        let m = flip(ndf.sample_visible(-d_own, rng), side);
+        order += 1;
+        if order >= RUNAWAY_ORDER {
+            observer.lose(Loss::Runaway, &weight);
+            return u64::from(order);
+        }
+        let branch = match facet.interact(-d, m, side, rng) {
+            Interaction::One(b) => b,
+            Interaction::Two(a, b) => match choose(&weight, a, b, open01(rng)) {
+                Some(chosen) => chosen,
+                None => return u64::from(order),
+            },
+        };
+        for (w, f) in weight.iter_mut().zip(&branch.weight) {
+            *w *= f;
+        }
+        if branch.crosses {
+            side = side.other();
+        }
+        d = branch.dir;
+        let p = visibility.leave(ndf, rate_in, flip(d, side), branch.crosses);
+        if !d.is_finite() || !p.is_finite() || weight.iter().any(|w| !w.is_finite()) {
+            observer.lose(Loss::Invalid, &weight);
+            return u64::from(order);
+        }
+        if p > 0.0 {
+            observer.escape(order, side, d, &weight.map(|w| w * p));
+            weight = weight.map(|w| w * (1.0 - p));
+        }
+        match roulette(&weight, policy.threshold, rng) {
+            Some(w) => weight = w,
+            None => return u64::from(order),
+        }
+    }
+}
