@@ -1,10 +1,11 @@
 //! `smithwalk compare`: a run's measured lobes against analytic models in the same bins, per
 //! case, order and hemisphere (THEORY.md §4.7, §9.5).
 //!
-//! Models: `single` (exact single scattering by adaptive quadrature, order 1, conductor and
-//! dielectric facets with the true Smith Lambda and visible normals), `heitz-nee` (next-event
+//! Models: `single` (exact single scattering by quadrature, order 1, every facet material with
+//! the true Smith Lambda and visible normals), `heitz-nee` (next-event
 //! estimation along the walk, every order), `wang-correlated` and `wang-uncorrelated` (the
-//! Wang et al. 2022 chains); the Monte Carlo models run into the same detector with their own
+//! Wang et al. 2022 chains), `exact-position-free` (the walk with its depths integrated out,
+//! §7.1, for one-sided facets); the Monte Carlo models run into the same detector with their own
 //! standard errors. `hammon-fit` is Hammon 2017's closed-form approximation for his facet
 //! (order 1 and all orders), integrated over the bins by quadrature.
 
@@ -15,7 +16,7 @@ use std::path::Path;
 use anyhow::Result;
 use microsurface::wang::Shadowing;
 
-use crate::config::Config;
+use crate::config::{Config, NormalsKind, SmithKind};
 use crate::detector::{Grid, Hemisphere};
 use crate::models::{HammonFitPart, hammon_fit_bins, single_scattering_bins};
 use crate::output::{case_fields, write_atomically};
@@ -32,11 +33,18 @@ pub enum Model {
     HeitzNee,
     WangCorrelated,
     WangUncorrelated,
+    ExactPositionFree,
 }
 
 impl Model {
-    pub const ALL: [Model; 5] =
-        [Model::Single, Model::HammonFit, Model::HeitzNee, Model::WangCorrelated, Model::WangUncorrelated];
+    pub const ALL: [Model; 6] = [
+        Model::Single,
+        Model::HammonFit,
+        Model::HeitzNee,
+        Model::WangCorrelated,
+        Model::WangUncorrelated,
+        Model::ExactPositionFree,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -45,6 +53,7 @@ impl Model {
             Model::HeitzNee => "heitz-nee",
             Model::WangCorrelated => "wang-correlated",
             Model::WangUncorrelated => "wang-uncorrelated",
+            Model::ExactPositionFree => "exact-position-free",
         }
     }
 
@@ -180,21 +189,30 @@ fn predict(
                 }
             }
         }
-        Model::HeitzNee | Model::WangCorrelated | Model::WangUncorrelated => {
+        Model::HeitzNee | Model::WangCorrelated | Model::WangUncorrelated | Model::ExactPositionFree => {
             let estimator = match model {
                 Model::WangCorrelated => Estimator::Wang(Shadowing::Correlated),
                 Model::WangUncorrelated => Estimator::Wang(Shadowing::Uncorrelated),
+                Model::ExactPositionFree => Estimator::PositionFree,
                 _ => Estimator::HeitzNee(NEE_DIRECTIONS),
             };
             let model_config = Config { seed, ..config.clone() };
             let options = RunOptions { estimator, shard: Shard::WHOLE, threads, show_progress: true };
             let sim = crate::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))?;
             for_each_lobe(&sim, &mut |case, order, hemisphere, channel, value| {
-                rows(case, order, hemisphere, channel, value, &mut out)
+                if model != Model::ExactPositionFree || position_free_applies(case) {
+                    rows(case, order, hemisphere, channel, value, &mut out)
+                }
             });
         }
     }
     Ok(out)
+}
+
+/// Whether the exact position-free form (§7.1) describes a case's walk: facets that reflect on
+/// one side, the true Smith Lambda and visible normals (the chain's own laws).
+fn position_free_applies(case: &crate::cases::Case) -> bool {
+    !case.material.transmits() && case.smith == SmithKind::Exact && case.normals == NormalsKind::Vndf
 }
 
 type LobeVisitor<'a> = dyn FnMut(&crate::cases::Case, usize, Hemisphere, &str, &mut dyn FnMut(usize) -> Value) + 'a;
@@ -270,15 +288,26 @@ impl Moments {
         if photons == 0 {
             return 0.0;
         }
-        let r = if self.mean > 0.0 { self.second / self.mean } else { 1.0 };
-        ((mu * r - mu * mu) / photons as f64).max(0.0)
+        ((mu * self.mean_weight() - mu * mu) / photons as f64).max(0.0)
+    }
+
+    /// The bin's mean weight per unit of energy, `r = q / e` (1 assumed for an empty bin).
+    fn mean_weight(&self) -> f64 {
+        if self.mean > 0.0 { self.second / self.mean } else { 1.0 }
     }
 }
 
 /// The common mean of a bin under the null hypothesis: the model's value for an exact model
-/// (`n_p = 0`), else the photon-weighted mean of the two Monte Carlo estimates.
+/// (`n_p = 0`), else the two Monte Carlo estimates weighted by their inverse variances at a
+/// common mean, `N / r` each. That weighting makes the common mean uncorrelated with their
+/// difference, so choosing bins by it (pooling) does not bias the test; the photon-weighted
+/// mean would favour the noisier estimate's upward fluctuations.
 fn null_mean(m: Moments, n_m: u64, p: Moments, n_p: u64) -> f64 {
-    if n_p == 0 { p.mean } else { (m.mean * n_m as f64 + p.mean * n_p as f64) / (n_m + n_p) as f64 }
+    if n_p == 0 {
+        return p.mean;
+    }
+    let (wm, wp) = (n_m as f64 / m.mean_weight(), n_p as f64 / p.mean_weight());
+    (m.mean * wm + p.mean * wp) / (wm + wp)
 }
 
 /// The z value of measured moments `m` (over `n_m` photons) against a model's `p` (over `n_p`

@@ -373,7 +373,8 @@ pub struct Config {
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct CompareConfig {
-    /// Model names: `single`, `hammon-fit`, `heitz-nee`, `wang-correlated`, `wang-uncorrelated`.
+    /// Model names: `single`, `hammon-fit`, `heitz-nee`, `exact-position-free`, `wang-correlated`,
+    /// `wang-uncorrelated`.
     pub models: Vec<String>,
     /// Photons per case for the Monte Carlo models (default: the run's `paths`).
     #[serde(default, skip_serializing_if = "Option::is_none")]

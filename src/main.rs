@@ -70,8 +70,14 @@ enum Command {
     Compare {
         /// The run's output directory (with run.json, lobes.csv and summary.csv).
         run_dir: PathBuf,
-        /// Comma-separated models: single, hammon-fit, heitz-nee, wang-correlated, wang-uncorrelated.
-        #[arg(long, value_delimiter = ',', value_parser = Model::parse, default_value = "single,hammon-fit,heitz-nee,wang-correlated,wang-uncorrelated")]
+        /// Comma-separated models: single, hammon-fit, heitz-nee, exact-position-free,
+        /// wang-correlated, wang-uncorrelated.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            value_parser = Model::parse,
+            default_value = "single,hammon-fit,heitz-nee,exact-position-free,wang-correlated,wang-uncorrelated"
+        )]
         models: Vec<Model>,
         /// Photons per case for the Monte Carlo models (default: the run's).
         #[arg(long)]
