@@ -75,7 +75,10 @@ fn exit_lobe<N: Ndf>(ndf: &N, wi: DVec3, wo: DVec3, visible: &[(DVec3, f64)], g:
 
 /// A quadrature rule for GGX visible normals seen from `wi`: in the stretched configuration
 /// they are `normalize(c + w')` with `c` uniform on the spherical cap `z > -w'_z` (§3.2, [DB23]),
-/// integrated by Gauss–Legendre in `z` and the trapezoid rule in the azimuth.
+/// integrated by Gauss–Legendre in `z` and the trapezoid rule in the azimuth. 32 x 64 nodes:
+/// bin energies then move by at most 7.6e-7 against 128 x 256 (measured on five diffuse and
+/// Hammon cases, alpha 0.05 to 1, up to 82 deg, 8 x 16 bins), below 0.1 standard error of a
+/// bin at 10^8 photons.
 fn ggx_visible_rule(ndf: &Ggx, wi: DVec3) -> Vec<(DVec3, f64)> {
     const NZ: usize = 32;
     const NPHI: usize = 64;
