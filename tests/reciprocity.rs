@@ -1,6 +1,6 @@
 //! Reciprocity of the walk (THEORY.md §2.6, §9.3), by next-event point estimates of the
 //! per-order lobe at fixed direction pairs: `f_k(wi, wo) = f_k(wo, wi)` for mirror, Lambertian
-//! and Hammon facets, and the power-form transmission identity
+//! and Hammon facets (orders 1 to 4), and the power-form transmission identity
 //! `f_t(wi, wo) / eta_o^2 = f_t(wo, wi) / eta_i^2` for the dielectric. Each estimate uses
 //! 4*10^5 photons; per order the two directions are compared by a z test with per-photon
 //! variances, at the Sidak level keeping the family (all pairs and orders) at 0.01.
@@ -20,7 +20,7 @@ use smithwalk::stats::sidak;
 use statrs::distribution::{ContinuousCDF, Normal};
 
 const PHOTONS: u64 = 400_000;
-const ORDERS: usize = 3;
+const ORDERS: usize = 4;
 
 /// Accumulates, per order, the next-event estimate of `f_k(wi, wo) |cos theta_o|` towards a
 /// fixed `wo`.
