@@ -128,22 +128,6 @@ impl Grid {
         self.cos_bins * self.phi_bins
     }
 
-    /// Bin index `cos_index * phi_bins + phi_index` of a direction whose azimuth relative to
-    /// the incident azimuth has cosine/sine given by the rotation `(cos_phi_i, sin_phi_i)`.
-    #[inline]
-    pub fn bin(&self, dir: DVec3, rotation: (f64, f64)) -> usize {
-        let (c, s) = rotation;
-        let ic = ((dir.z.abs() * self.cos_bins as f64) as usize).min(self.cos_bins - 1);
-        let x = c * dir.x + s * dir.y;
-        let y = c * dir.y - s * dir.x;
-        let mut phi = y.atan2(x);
-        if phi < 0.0 {
-            phi += std::f64::consts::TAU;
-        }
-        let ip = ((phi * (self.phi_bins as f64 / std::f64::consts::TAU)) as usize).min(self.phi_bins - 1);
-        ic * self.phi_bins + ip
-    }
-
     /// `[|cos| lo, |cos| hi]` of a cos index.
     pub fn cos_edges(&self, ic: usize) -> (f64, f64) {
         (ic as f64 / self.cos_bins as f64, (ic + 1) as f64 / self.cos_bins as f64)
@@ -248,11 +232,73 @@ impl<const C: usize> Tallies<C> {
     }
 }
 
+/// The "diamond angle" of a planar direction `(x, y)`: a monotone function of its azimuth
+/// `atan2(y, x)` taken in `[0, 2 pi)`, onto `[0, 4)`, without trigonometry (one division).
+#[inline]
+fn diamond_angle(x: f64, y: f64) -> f64 {
+    let l1 = x.abs() + y.abs();
+    if l1 == 0.0 {
+        return 0.0;
+    }
+    let t = x / l1;
+    if y >= 0.0 { 1.0 - t } else { 3.0 + t }
+}
+
+/// Bins escaping directions: |cos theta| directly, and the azimuth relative to the incident
+/// azimuth without trigonometry. The diamond angle of the rotated direction is looked up in a
+/// table of `4 phi_bins` equal cells, each holding the number of bin edges
+/// (`2 pi k / phi_bins`, as diamond angles) at or below its start and the edge inside it, if
+/// any (edges are at least `pi / (2 phi_bins)` apart in diamond angle, so a cell holds at
+/// most one).
+#[derive(Clone, Debug)]
+struct Binner {
+    grid: Grid,
+    /// `(cos phi_i, sin phi_i)` of the incident azimuth.
+    rotation: (f64, f64),
+    /// Per cell: edges at or below its start, and the edge inside it (`inf` if none).
+    cells: Vec<(usize, f64)>,
+}
+
+impl Binner {
+    fn new(grid: Grid, rotation: (f64, f64)) -> Self {
+        let n = grid.phi_bins;
+        let edges: Vec<f64> = (1..n)
+            .map(|k| {
+                let (s, c) = (std::f64::consts::TAU * k as f64 / n as f64).sin_cos();
+                diamond_angle(c, s)
+            })
+            .collect();
+        let count = 4 * n;
+        let cells = (0..count)
+            .map(|i| {
+                let (start, end) = (4.0 * i as f64 / count as f64, 4.0 * (i + 1) as f64 / count as f64);
+                let below = edges.partition_point(|&e| e <= start);
+                let inside = edges.get(below).copied().filter(|&e| e < end).unwrap_or(f64::INFINITY);
+                (below, inside)
+            })
+            .collect();
+        Self { grid, rotation, cells }
+    }
+
+    /// Bin index `cos_index * phi_bins + phi_index` of an escaping direction.
+    #[inline]
+    fn bin(&self, dir: DVec3) -> usize {
+        let g = self.grid;
+        let ic = ((dir.z.abs() * g.cos_bins as f64) as usize).min(g.cos_bins - 1);
+        let (c, s) = self.rotation;
+        let p = diamond_angle(c * dir.x + s * dir.y, c * dir.y - s * dir.x);
+        let cell = ((p * 0.25 * self.cells.len() as f64) as usize).min(self.cells.len() - 1);
+        let (below, edge) = self.cells[cell];
+        let ip = (below + usize::from(p >= edge)).min(g.phi_bins - 1);
+        ic * g.phi_bins + ip
+    }
+}
+
 /// The detector of one case: its geometry, its tallies, and the escapes of the photon in flight.
 #[derive(Clone, Debug)]
 pub struct Detector<const C: usize> {
     pub grid: Grid,
-    rotation: (f64, f64),
+    binner: Binner,
     incident_side: Side,
     max_order: Option<u32>,
     pub tallies: Tallies<C>,
@@ -284,7 +330,7 @@ impl<const C: usize> Detector<C> {
         let rotation = if horizontal > 0.0 { (wi.x / horizontal, wi.y / horizontal) } else { (1.0, 0.0) };
         Self {
             grid,
-            rotation,
+            binner: Binner::new(grid, rotation),
             incident_side: if wi.z >= 0.0 { Side::Outside } else { Side::Inside },
             max_order,
             tallies: Tallies::new(&grid),
@@ -385,12 +431,58 @@ impl<const C: usize> Observer<C> for Detector<C> {
     #[inline]
     fn escape(&mut self, order: u32, side: Side, dir: DVec3, weight: &[f64; C]) {
         let hemisphere = if side == self.incident_side { Hemisphere::R } else { Hemisphere::T };
-        let bin = self.grid.bin(dir, self.rotation);
+        let bin = self.binner.bin(dir);
         self.pending.push(Deposit { slot: self.slot(order), hemisphere, bin, weight: *weight });
     }
 
     fn lose(&mut self, loss: Loss, weight: &[f64; C]) {
         accumulate(&mut self.pending_loss[loss_index(loss)], weight);
         self.any_loss = true;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_pcg::Pcg64Mcg;
+
+    /// The trigonometric reference: `floor(phi n / 2 pi)` of `phi = atan2` in `[0, 2 pi)`.
+    fn reference_phi_bin(n: usize, x: f64, y: f64) -> (usize, f64) {
+        let phi = y.atan2(x).rem_euclid(std::f64::consts::TAU);
+        let u = phi * n as f64 / std::f64::consts::TAU;
+        ((u as usize).min(n - 1), (u - u.round()).abs())
+    }
+
+    #[test]
+    fn azimuth_bins_agree_with_atan2() {
+        // 10^5 random directions per grid and rotation; directions within 1e-9 of a bin edge
+        // (in units of bins) are skipped, where rounding may legitimately go either way. The
+        // axes and the diagonals, where the diamond angle changes branch, are checked exactly.
+        let mut rng = Pcg64Mcg::seed_from_u64(5);
+        for n in [1, 2, 3, 7, 64, 360, 1000] {
+            for phi_i in [0.0_f64, 0.3, 2.0, -2.5] {
+                let rotation = (phi_i.cos(), phi_i.sin());
+                let binner = Binner::new(Grid { cos_bins: 4, phi_bins: n }, rotation);
+                let check = |d: DVec3| {
+                    let (c, s) = rotation;
+                    let (x, y) = (c * d.x + s * d.y, c * d.y - s * d.x);
+                    let (want, distance) = reference_phi_bin(n, x, y);
+                    if n == 1 || distance > 1e-9 {
+                        assert_eq!(binner.bin(d) % n, want, "n {n}, phi_i {phi_i}, d {d:?}");
+                    }
+                };
+                for _ in 0..100_000 {
+                    let phi = std::f64::consts::TAU * crate::microsurface::random::open01(&mut rng);
+                    let z = 2.0 * crate::microsurface::random::open01(&mut rng) - 1.0;
+                    let r = (1.0 - z * z).sqrt();
+                    check(DVec3::new(r * phi.cos(), r * phi.sin(), z));
+                }
+                for k in 0..8 {
+                    let a = phi_i + std::f64::consts::FRAC_PI_4 * k as f64 + 1e-6;
+                    check(DVec3::new(a.cos(), a.sin(), 0.0));
+                }
+            }
+        }
     }
 }

@@ -11,7 +11,7 @@ use rand::Rng;
 
 use crate::fresnel;
 use crate::ndf::Ndf;
-use crate::random::open01;
+use crate::random::{open01, unit_circle};
 use crate::roots::newton_bisect;
 
 /// Which side of the heightfield a ray is on (§4.3): outside (above) or inside (below, only
@@ -222,7 +222,7 @@ impl<const C: usize> Facet<C> for Lambertian<C> {
     fn interact<R: Rng + ?Sized>(&self, _w: DVec3, m: DVec3, _side: Side, rng: &mut R) -> Interaction<C> {
         let u = open01(rng);
         let cos_theta = (1.0 - u).sqrt();
-        let dir = about_normal(m, cos_theta, 2.0 * PI * open01(rng));
+        let dir = about_normal(m, cos_theta, unit_circle(rng));
         Interaction::One(Branch { dir, weight: self.albedo, crosses: false })
     }
 
@@ -256,7 +256,7 @@ impl<const C: usize> Facet<C> for Hammon<C> {
         let f = self.f0.map(|f0| fresnel::schlick(f0, w.dot(m)));
         let specular = Branch { dir: reflect(w, m), weight: f, crosses: false };
         let cos_theta = hammon_exit_cosine(open01(rng));
-        let dir = about_normal(m, cos_theta, 2.0 * PI * open01(rng));
+        let dir = about_normal(m, cos_theta, unit_circle(rng));
         let weight = std::array::from_fn(|i| (1.0 - f[i]) * self.albedo[i]);
         Interaction::Two(specular, Branch { dir, weight, crosses: false })
     }
@@ -287,12 +287,12 @@ impl<const C: usize> Facet<C> for Hammon<C> {
 /// Hammon's normalization of the Fresnel-weighted exit lobe, `k = 21 / (20 pi)` (§4.5).
 const HAMMON_K: f64 = 21.0 / (20.0 * PI);
 
-/// The direction at polar angle `acos(cos_theta)` and azimuth `phi` about the unit vector `m`.
+/// The direction at polar angle `acos(cos_theta)` and azimuth `(cos phi, sin phi)` about the
+/// unit vector `m`.
 #[inline]
-fn about_normal(m: DVec3, cos_theta: f64, phi: f64) -> DVec3 {
+fn about_normal(m: DVec3, cos_theta: f64, (c, s): (f64, f64)) -> DVec3 {
     let (t, b) = m.any_orthonormal_pair();
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    let (s, c) = phi.sin_cos();
     (sin_theta * c * t + sin_theta * s * b + cos_theta * m).normalize()
 }
 

@@ -11,7 +11,7 @@ use glam::DVec3;
 use rand::Rng;
 use statrs::function::erf::{erf_inv, erfc};
 
-use crate::random::open01;
+use crate::random::{open01, unit_circle};
 use crate::roots::newton_bisect;
 
 const SQRT_PI: f64 = 1.772_453_850_905_516;
@@ -119,10 +119,9 @@ impl Ndf for Ggx {
     /// Dupuy & Benyoub 2023 spherical caps (§3.2), exact on the full sphere.
     fn sample_visible<R: Rng + ?Sized>(&self, w: DVec3, rng: &mut R) -> DVec3 {
         let ws = self.0.stretch(w);
-        let phi = 2.0 * PI * open01(rng);
+        let (c, s) = unit_circle(rng);
         let z = (1.0 - open01(rng)) * (1.0 + ws.z) - ws.z;
         let sin_theta = (1.0 - z * z).max(0.0).sqrt();
-        let (s, c) = phi.sin_cos();
         let h = DVec3::new(sin_theta * c, sin_theta * s, z) + ws;
         self.0.unstretch_normal(DVec3::new(h.x, h.y, h.z.max(0.0)))
     }

@@ -18,3 +18,19 @@ pub fn open01<R: Rng + ?Sized>(rng: &mut R) -> f64 {
 pub fn exp1<R: Rng + ?Sized>(rng: &mut R) -> f64 {
     -open01(rng).ln()
 }
+
+/// A uniformly distributed unit vector `(cos phi, sin phi)` in the plane, without trigonometry:
+/// a point uniform in the square `[-1, 1]^2`, kept if it falls inside the unit disk (probability
+/// pi / 4) away from the centre, then normalised.
+#[inline]
+pub fn unit_circle<R: Rng + ?Sized>(rng: &mut R) -> (f64, f64) {
+    loop {
+        let x = 2.0 * open01(rng) - 1.0;
+        let y = 2.0 * open01(rng) - 1.0;
+        let r2 = x * x + y * y;
+        if r2 <= 1.0 && r2 > 1e-12 {
+            let inv = 1.0 / r2.sqrt();
+            return (x * inv, y * inv);
+        }
+    }
+}
