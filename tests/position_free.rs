@@ -15,7 +15,7 @@
 
 mod common;
 
-use common::{albedo, bin_counts, mono, simulate_with, weighted_bins};
+use common::{CONDUCTOR_ORDERS, assert_lobes_agree, check_orders, mono, simulate_with, two_sided_z};
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use smithwalk::detector::Hemisphere;
@@ -24,7 +24,7 @@ use smithwalk::microsurface::position_free::DepthProfile;
 use smithwalk::microsurface::random::exp1;
 use smithwalk::output::EnergyBalance;
 use smithwalk::run::Estimator;
-use smithwalk::stats::{sidak, two_sample};
+use smithwalk::stats::sidak;
 
 /// Follows a pattern of depth rates (first: the entering direction, down; then `(rate, up)`)
 /// and returns the absolute probability of escaping at each upward step.
@@ -99,37 +99,15 @@ fn depth_profile_matches_closed_forms_and_a_direct_simulation() {
 
 #[test]
 fn per_order_albedos_match_the_walk_table() {
-    // (alpha, theta, E1..E6) from THEORY.md §9.4 (walk, 2e6 photons, SE <= 4e-4).
-    let table: [(f64, f64, [f64; 6]); 8] = [
-        (0.5, 0.0, [0.6883, 0.2316, 0.0642, 0.0135, 0.0021, 0.0003]),
-        (0.5, 30.0, [0.6821, 0.2396, 0.0636, 0.0125, 0.0020, 0.0002]),
-        (0.5, 60.0, [0.6982, 0.2400, 0.0524, 0.0083, 0.0010, 0.0001]),
-        (0.5, 80.0, [0.8057, 0.1711, 0.0212, 0.0019, 0.0001, 0.0000]),
-        (1.0, 0.0, [0.3069, 0.3225, 0.2110, 0.1025, 0.0397, 0.0127]),
-        (1.0, 30.0, [0.3347, 0.3284, 0.2009, 0.0904, 0.0325, 0.0098]),
-        (1.0, 60.0, [0.4509, 0.3307, 0.1506, 0.0506, 0.0135, 0.0030]),
-        (1.0, 80.0, [0.6681, 0.2585, 0.0612, 0.0105, 0.0015, 0.0002]),
-    ];
-    let rounding: f64 = 5e-5 / 3f64.sqrt();
-    for (i, (alpha, theta, row)) in table.into_iter().enumerate() {
+    for (i, (alpha, theta, row)) in CONDUCTOR_ORDERS.into_iter().enumerate() {
         let toml = format!(
             "paths = 1_000_000\nseed = {}\n[surface]\nalpha = {alpha}\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 8\n",
             3000 + i
         );
         let sim = simulate_with(&toml, Estimator::PositionFree);
-        let d = mono(&sim, 0);
         let balance = EnergyBalance::from_result(&sim.results[0]);
         assert!((balance.reflected[0] - 1.0).abs() < 5e-4, "white furnace: {}", balance.reflected[0]);
-        for (k, &reference) in row.iter().enumerate() {
-            let (e, se) = albedo(d, k + 1, Hemisphere::R);
-            let se_ref = (reference * (1.0 - reference) / 2e6).sqrt().max(if reference > 0.0 { 0.0 } else { 1e-5 });
-            let tol = 4.0 * (se * se + se_ref * se_ref + rounding * rounding).sqrt();
-            assert!(
-                (e - reference).abs() <= tol,
-                "alpha {alpha} theta {theta} E{}: {e:.5} +- {se:.5}, table {reference}",
-                k + 1
-            );
-        }
+        check_orders(mono(&sim, 0), Hemisphere::R, &row, 2e6, &format!("alpha {alpha} theta {theta}"));
     }
 }
 
@@ -153,8 +131,7 @@ fn lobes_of_every_order_match_the_walk() {
     let slots = [0usize, 1, 2, 3, 4];
     let orders = 1..=5usize;
     let level = sidak(0.01, cases.len() * (slots.len() + orders.clone().count()));
-    let z_limit =
-        statrs::distribution::ContinuousCDF::inverse_cdf(&statrs::distribution::Normal::standard(), 1.0 - level / 2.0);
+    let z_limit = two_sided_z(level);
     for (i, (surface, material, incident)) in cases.into_iter().enumerate() {
         let toml = |seed: u64| {
             format!(
@@ -163,30 +140,17 @@ fn lobes_of_every_order_match_the_walk() {
         };
         let walk = simulate_with(&toml(3100 + i as u64), Estimator::Walk);
         let chain = simulate_with(&toml(3200 + i as u64), Estimator::PositionFree);
-        let (a, b) = (mono(&walk, 0), mono(&chain, 0));
-        let h = Hemisphere::R;
-        for slot in slots {
-            let test = two_sample(
-                &weighted_bins(a, slot, h),
-                a.tallies.photons,
-                &weighted_bins(b, slot, h),
-                b.tallies.photons,
-                &bin_counts(a, slot, h),
-                10,
-            );
-            println!("case {i} slot {slot}: chi2 {:.1} dof {} p {:.3e}", test.statistic, test.dof, test.p_value);
-            assert!(test.dof >= 8, "case {i} slot {slot}: only {} cells", test.dof);
-            assert!(
-                test.p_value > level,
-                "case {i} slot {slot}: walk vs position-free rejected\n{}",
-                test.worst_cells(10)
-            );
-        }
-        for k in orders.clone() {
-            let (x, y) = (albedo(a, k, h), albedo(b, k, h));
-            let z = (x.0 - y.0) / (x.1 * x.1 + y.1 * y.1).sqrt();
-            assert!(z.abs() < z_limit, "case {i} order {k}: walk {x:?} vs position-free {y:?}, z = {z:.2}");
-        }
+        let label = format!("case {i}");
+        assert_lobes_agree(
+            mono(&walk, 0),
+            mono(&chain, 0),
+            Hemisphere::R,
+            &slots,
+            orders.clone(),
+            level,
+            z_limit,
+            &label,
+        );
     }
 }
 

@@ -68,3 +68,71 @@ pub fn dir(theta_deg: f64, phi_deg: f64) -> DVec3 {
     let (sp, cp) = phi_deg.to_radians().sin_cos();
     DVec3::new(st * cp, st * sp, ct)
 }
+
+/// THEORY.md §9.4: per-order albedos E1..E6 of the random walk, conductor F = 1, isotropic
+/// GGX, (alpha, theta_i deg); 2*10^6 photons, SE <= 4e-4, rounded to 4 decimals.
+pub const CONDUCTOR_ORDERS: [(f64, f64, [f64; 6]); 8] = [
+    (0.5, 0.0, [0.6883, 0.2316, 0.0642, 0.0135, 0.0021, 0.0003]),
+    (0.5, 30.0, [0.6821, 0.2396, 0.0636, 0.0125, 0.0020, 0.0002]),
+    (0.5, 60.0, [0.6982, 0.2400, 0.0524, 0.0083, 0.0010, 0.0001]),
+    (0.5, 80.0, [0.8057, 0.1711, 0.0212, 0.0019, 0.0001, 0.0000]),
+    (1.0, 0.0, [0.3069, 0.3225, 0.2110, 0.1025, 0.0397, 0.0127]),
+    (1.0, 30.0, [0.3347, 0.3284, 0.2009, 0.0904, 0.0325, 0.0098]),
+    (1.0, 60.0, [0.4509, 0.3307, 0.1506, 0.0506, 0.0135, 0.0030]),
+    (1.0, 80.0, [0.6681, 0.2585, 0.0612, 0.0105, 0.0015, 0.0002]),
+];
+
+/// Checks per-order albedos (orders 1, 2, ...) of `d` against a reference row from
+/// `ref_photons` photons rounded to 4 decimals: within 4 combined standard errors (ours, the
+/// reference's binomial SE and its rounding).
+pub fn check_orders(d: &Detector<1>, hemisphere: Hemisphere, reference: &[f64], ref_photons: f64, label: &str) {
+    let rounding: f64 = 5e-5 / 3f64.sqrt();
+    for (k, &r) in reference.iter().enumerate() {
+        let (e, se) = albedo(d, k + 1, hemisphere);
+        let se_ref = (r * (1.0 - r) / ref_photons).sqrt();
+        let tol = 4.0 * (se * se + se_ref * se_ref + rounding * rounding).sqrt();
+        assert!((e - r).abs() <= tol, "{label} E{}: {e:.5} +- {se:.5}, reference {r} (tol {tol:.5})", k + 1);
+    }
+}
+
+/// Two estimators of the same lobes agree: for each order slot, a two-sample chi-square with
+/// per-photon variances, pooling bins with fewer than 10 photons in `a` (at least 8 cells
+/// left), at `level`; for each order of `orders`, the albedos by a z test below `z_limit`.
+#[allow(clippy::too_many_arguments)]
+pub fn assert_lobes_agree(
+    a: &Detector<1>,
+    b: &Detector<1>,
+    hemisphere: Hemisphere,
+    slots: &[usize],
+    orders: std::ops::RangeInclusive<usize>,
+    level: f64,
+    z_limit: f64,
+    label: &str,
+) {
+    for &slot in slots {
+        let test = smithwalk::stats::two_sample(
+            &weighted_bins(a, slot, hemisphere),
+            a.tallies.photons,
+            &weighted_bins(b, slot, hemisphere),
+            b.tallies.photons,
+            &bin_counts(a, slot, hemisphere),
+            10,
+        );
+        println!(
+            "{label} slot {slot} {hemisphere:?}: chi2 {:.1} dof {} p {:.3e}",
+            test.statistic, test.dof, test.p_value
+        );
+        assert!(test.dof >= 8, "{label} slot {slot} {hemisphere:?}: only {} cells", test.dof);
+        assert!(test.p_value > level, "{label} slot {slot} {hemisphere:?}: rejected\n{}", test.worst_cells(10));
+    }
+    for k in orders {
+        let (x, y) = (albedo(a, k, hemisphere), albedo(b, k, hemisphere));
+        let z = (x.0 - y.0) / (x.1 * x.1 + y.1 * y.1).sqrt();
+        assert!(z.abs() < z_limit, "{label} order {k} {hemisphere:?}: {x:?} vs {y:?}, z = {z:.2}");
+    }
+}
+
+/// The two-sided standard-normal quantile for a test at `level`: `|z|` beyond it rejects.
+pub fn two_sided_z(level: f64) -> f64 {
+    statrs::distribution::ContinuousCDF::inverse_cdf(&statrs::distribution::Normal::standard(), 1.0 - level / 2.0)
+}
