@@ -22,7 +22,7 @@ use crate::models::{HammonFitPart, hammon_fit_bins, single_scattering_bins};
 use crate::output::{case_fields, write_atomically};
 use crate::run::{Estimator, Shard};
 use crate::rundir::{Table, read_config};
-use crate::stats::{Cell, ChiSquare};
+use crate::stats::{self, ChiSquare, WeightedBin};
 use crate::{RunOptions, Simulation};
 
 /// The analytic models `compare` knows.
@@ -263,78 +263,26 @@ impl LobeComparison {
     }
 }
 
-/// A Monte Carlo bin as per-photon moments: mean `e` and second moment `q = Q/N`, recovered
-/// from the written energy and standard error (`se^2 = (q - e^2) / (N - 1)`).
-#[derive(Clone, Copy, Default)]
-struct Moments {
-    mean: f64,
-    second: f64,
+/// A bin as per-photon moments: mean `e` and second moment `q = Q/N`, recovered from the
+/// written energy and standard error (`se^2 = (q - e^2) / (N - 1)`).
+fn moments(v: Value, photons: u64) -> WeightedBin {
+    let n = photons as f64;
+    WeightedBin { mean: v.energy, second_moment: v.stderr * v.stderr * (n - 1.0) + v.energy * v.energy }
 }
 
-impl Moments {
-    fn of(v: Value, photons: u64) -> Self {
-        let n = photons as f64;
-        Self { mean: v.energy, second: v.stderr * v.stderr * (n - 1.0) + v.energy * v.energy }
-    }
-
-    fn add(&mut self, other: Moments) {
-        self.mean += other.mean;
-        self.second += other.second;
-    }
-
-    /// Variance of the mean over `photons` photons if the true mean were `mu`: `(mu r - mu^2) / N`
-    /// with `r = q / e` the bin's mean weight (1 for unit weights; 1 assumed for empty bins).
-    fn variance_at(&self, mu: f64, photons: u64) -> f64 {
-        if photons == 0 {
-            return 0.0;
-        }
-        ((mu * self.mean_weight() - mu * mu) / photons as f64).max(0.0)
-    }
-
-    /// The bin's mean weight per unit of energy, `r = q / e` (1 assumed for an empty bin).
-    fn mean_weight(&self) -> f64 {
-        if self.mean > 0.0 { self.second / self.mean } else { 1.0 }
-    }
-}
-
-/// The common mean of a bin under the null hypothesis: the model's value for an exact model
-/// (`n_p = 0`), else the two Monte Carlo estimates weighted by their inverse variances at a
-/// common mean, `N / r` each. That weighting makes the common mean uncorrelated with their
-/// difference, so choosing bins by it (pooling) does not bias the test; the photon-weighted
-/// mean would favour the noisier estimate's upward fluctuations.
-fn null_mean(m: Moments, n_m: u64, p: Moments, n_p: u64) -> f64 {
-    if n_p == 0 {
-        return p.mean;
-    }
-    let (wm, wp) = (n_m as f64 / m.mean_weight(), n_p as f64 / p.mean_weight());
-    (m.mean * wm + p.mean * wp) / (wm + wp)
-}
-
-/// The z value of measured moments `m` (over `n_m` photons) against a model's `p` (over `n_p`
-/// photons, 0 for an exact model). Variances are evaluated at the common mean under the null
-/// hypothesis (the model's value, or the photon-weighted mean of two Monte Carlo estimates),
-/// not at the observed values, which would inflate the statistic in sparse bins.
-fn z_value(m: Moments, n_m: u64, p: Moments, n_p: u64) -> Option<f64> {
-    let mu = null_mean(m, n_m, p, n_p);
-    let var = m.variance_at(mu, n_m) + p.variance_at(mu, n_p);
-    (var > 0.0).then(|| (m.mean - p.mean) / var.sqrt())
-}
-
-/// Compares one lobe bin by bin with [`z_value`]; bins in which fewer than 5 photons are
-/// expected under the null hypothesis ([`null_mean`]) are pooled into one cell. (Pooling by
-/// either estimate alone would keep exactly the bins where that estimate fluctuated up, and
-/// bias the kept differences.)
+/// Compares one lobe bin by bin with [`stats::two_sample_at_null`] (the model exact when
+/// `model_photons = 0`), pooling bins in which less than 5 photons' worth of energy is
+/// expected; also the relative L1 and L2 errors and the model's albedo.
 fn compare_lobe(
     measured: &HashMap<BinKey, Value>,
     predictions: &[&Prediction],
     photons: u64,
     model_photons: u64,
 ) -> (ChiSquare, f64, f64, Value) {
-    let mut cells = Vec::new();
-    let (mut pool_m, mut pool_p, mut pool_bins) = (Moments::default(), Moments::default(), Vec::new());
     let (mut l1, mut l2, mut norm1, mut norm2) = (0.0, 0.0, 0.0, 0.0);
     let (mut albedo, mut albedo_var) = (0.0, 0.0);
-    for (i, p) in predictions.iter().enumerate() {
+    let (mut observed, mut model) = (Vec::new(), Vec::new());
+    for p in predictions {
         let m = measured.get(&p.key).copied().unwrap_or_default();
         let (o, e) = (m.energy, p.value.energy);
         l1 += (o - e).abs();
@@ -343,26 +291,13 @@ fn compare_lobe(
         norm2 += e * e;
         albedo += e;
         albedo_var += p.value.stderr * p.value.stderr;
-        let (mm, pm) = (Moments::of(m, photons), Moments::of(p.value, model_photons));
-        match z_value(mm, photons, pm, model_photons) {
-            Some(z) if photons as f64 * null_mean(mm, photons, pm, model_photons) >= 5.0 => {
-                cells.push(Cell { bins: vec![i], observed: o, expected: e, z });
-            }
-            _ => {
-                pool_m.add(mm);
-                pool_p.add(pm);
-                pool_bins.push(i);
-            }
-        }
+        observed.push(moments(m, photons));
+        model.push(moments(p.value, model_photons));
     }
-    if photons as f64 * null_mean(pool_m, photons, pool_p, model_photons) >= 5.0 {
-        if let Some(z) = z_value(pool_m, photons, pool_p, model_photons) {
-            cells.push(Cell { bins: pool_bins, observed: pool_m.mean, expected: pool_p.mean, z });
-        }
-    }
+    let test = stats::two_sample_at_null(&observed, photons, &model, model_photons, 5.0);
     let rel_l1 = if norm1 > 0.0 { l1 / norm1 } else { 0.0 };
     let rel_l2 = if norm2 > 0.0 { (l2 / norm2).sqrt() } else { 0.0 };
-    (ChiSquare::from_cells(cells), rel_l1, rel_l2, Value { energy: albedo, stderr: albedo_var.sqrt() })
+    (test, rel_l1, rel_l2, Value { energy: albedo, stderr: albedo_var.sqrt() })
 }
 
 /// Runs the comparison of `run_dir` with `models` and writes `models.csv` and `compare.csv`

@@ -1,5 +1,6 @@
 //! Statistical tests of weighted histograms (THEORY.md §9.5): chi-square against expected bin
-//! integrals, two-sample chi-square, Sidak correction. Used by the test suite and the CLI.
+//! integrals, two-sample chi-square of two Monte Carlo estimates, Sidak correction. Used by
+//! the test suite and by `smithwalk compare`.
 //!
 //! Bins are described by per-photon means: `mean = S/N` (the energy through the bin) and the
 //! per-photon second moment `Q/N`. Under the null hypothesis the variance of a bin's mean is
@@ -101,8 +102,77 @@ pub fn chi_square(observed: &[WeightedBin], expected: &[f64], photons: u64, min_
     ChiSquare::from_cells(cells)
 }
 
-/// Two-sample chi-square of two independent weighted histograms of the same quantity, with
-/// `n1` and `n2` photons: `z = (m1 - m2) / sqrt(v1 + v2)` per cell with per-photon variances;
+impl WeightedBin {
+    /// The bin's mean weight `r = Q / S` (1 assumed for an empty bin).
+    fn mean_weight(&self) -> f64 {
+        if self.mean > 0.0 { self.second_moment / self.mean } else { 1.0 }
+    }
+
+    /// Variance of the mean over `n` photons if the true mean were `mu`: `(mu r - mu^2) / n`.
+    fn variance_at(&self, mu: f64, n: f64) -> f64 {
+        ((mu * self.mean_weight() - mu * mu) / n).max(0.0)
+    }
+
+    fn add(&mut self, other: &WeightedBin) {
+        self.mean += other.mean;
+        self.second_moment += other.second_moment;
+    }
+}
+
+/// The comparison of `smithwalk compare`: a two-sample chi-square of two independent weighted
+/// histograms of the same quantity, with `n1` and `n2` photons; `n2 = 0` makes `b` an exact
+/// expectation (no variance).
+///
+/// Per bin, `z = (m1 - m2) / sqrt(v1(mu) + v2(mu))` with the variances evaluated at the common
+/// mean `mu` of the null hypothesis, not at the observed means (which inflates the statistic
+/// in sparse bins). For two Monte Carlo samples `mu` weights their means by their inverse
+/// variances at a common mean, `N / r` each: that makes it uncorrelated with their
+/// difference, so choosing bins by it does not bias the test. Bins in which less than
+/// `min_count` photons' worth of energy is expected in `a` (`n1 mu`) are pooled into one
+/// cell, tested too if it reaches `min_count`. (Pooling by either sample's own counts, or by
+/// the plain average, keeps the bins where the noisier sample fluctuated up.)
+pub fn two_sample_at_null(a: &[WeightedBin], n1: u64, b: &[WeightedBin], n2: u64, min_count: f64) -> ChiSquare {
+    let exact = n2 == 0;
+    let (n1, n2) = (n1 as f64, n2 as f64);
+    let common_mean = |x: &WeightedBin, y: &WeightedBin| {
+        if exact {
+            return y.mean;
+        }
+        let (wx, wy) = (n1 / x.mean_weight(), n2 / y.mean_weight());
+        (x.mean * wx + y.mean * wy) / (wx + wy)
+    };
+    let expected_count = |mu: f64| n1 * mu;
+    let z = |x: &WeightedBin, y: &WeightedBin, mu: f64| {
+        let v = x.variance_at(mu, n1) + if exact { 0.0 } else { y.variance_at(mu, n2) };
+        (v > 0.0).then(|| (x.mean - y.mean) / v.sqrt())
+    };
+    let mut cells = Vec::new();
+    let zero = WeightedBin { mean: 0.0, second_moment: 0.0 };
+    let (mut pool_bins, mut pool_a, mut pool_b) = (Vec::new(), zero, zero);
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        let mu = common_mean(x, y);
+        match z(x, y, mu) {
+            Some(z) if expected_count(mu) >= min_count => {
+                cells.push(Cell { bins: vec![i], observed: x.mean, expected: y.mean, z });
+            }
+            _ => {
+                pool_bins.push(i);
+                pool_a.add(x);
+                pool_b.add(y);
+            }
+        }
+    }
+    let mu = common_mean(&pool_a, &pool_b);
+    if !pool_bins.is_empty() && expected_count(mu) >= min_count {
+        if let Some(z) = z(&pool_a, &pool_b, mu) {
+            cells.push(Cell { bins: pool_bins, observed: pool_a.mean, expected: pool_b.mean, z });
+        }
+    }
+    ChiSquare::from_cells(cells)
+}
+
+/// The test suite's two-sample chi-square of two independent weighted histograms of the same
+/// quantity, with `n1` and `n2` photons: `z = (m1 - m2) / sqrt(v1 + v2)` per cell with per-photon variances;
 /// bins with fewer than `min_count` photons in the two samples together are pooled.
 pub fn two_sample(a: &[WeightedBin], n1: u64, b: &[WeightedBin], n2: u64, counts: &[u64], min_count: u64) -> ChiSquare {
     let var = |bin: &WeightedBin, n: f64| ((bin.second_moment - bin.mean * bin.mean) / (n - 1.0)).max(0.0);
@@ -156,5 +226,23 @@ mod tests {
         // Pearson by hand: 1000 * (0.01/0.21 + 0.01/0.21) = 95.238...
         assert!((wrong.statistic - 1000.0 * 2.0 * 0.01 / 0.21).abs() < 1e-9, "{}", wrong.statistic);
         assert!(wrong.p_value < 1e-15);
+    }
+
+    #[test]
+    fn the_compare_statistic_is_pearson_for_an_exact_model_and_zero_for_equal_samples() {
+        // Unit weights (second moment = mean), exact model (n2 = 0): the same Pearson sums as
+        // above, and 95.238... for the shifted model.
+        let counts = [400.0, 300.0, 200.0, 100.0];
+        let obs: Vec<WeightedBin> =
+            counts.iter().map(|c| WeightedBin { mean: c / 1000.0, second_moment: c / 1000.0 }).collect();
+        let exact = |p: [f64; 4]| p.map(|mean| WeightedBin { mean, second_moment: 0.0 });
+        assert_eq!(two_sample_at_null(&obs, 1000, &exact([0.4, 0.3, 0.2, 0.1]), 0, 5.0).statistic, 0.0);
+        let wrong = two_sample_at_null(&obs, 1000, &exact([0.3, 0.3, 0.3, 0.1]), 0, 5.0);
+        assert!((wrong.statistic - 1000.0 * 2.0 * 0.01 / 0.21).abs() < 1e-9, "{}", wrong.statistic);
+        // Two samples with equal means agree exactly; halving one sample's means is rejected.
+        assert_eq!(two_sample_at_null(&obs, 1000, &obs, 1000, 5.0).statistic, 0.0);
+        let half: Vec<WeightedBin> =
+            obs.iter().map(|b| WeightedBin { mean: b.mean / 2.0, second_moment: b.second_moment / 2.0 }).collect();
+        assert!(two_sample_at_null(&obs, 1000, &half, 1000, 5.0).p_value < 1e-10);
     }
 }
