@@ -33,6 +33,12 @@ impl Case {
         };
         DVec3::new(st * cp, st * sp, z)
     }
+
+    /// Whether the exact position-free form (THEORY.md §7.1) describes this case's walk: facets
+    /// that reflect on one side, the true Smith Lambda and visible normals (the chain's laws).
+    pub fn position_free_applies(&self) -> bool {
+        !self.material.transmits() && self.smith == SmithKind::Exact && self.normals == NormalsKind::Vndf
+    }
 }
 
 /// The cases of a configuration, in the order ndf, alpha, height, smith, normals, material,

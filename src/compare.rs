@@ -16,7 +16,7 @@ use std::path::Path;
 use anyhow::Result;
 use microsurface::wang::Shadowing;
 
-use crate::config::{Config, NormalsKind, SmithKind};
+use crate::config::Config;
 use crate::detector::{Grid, Hemisphere};
 use crate::models::{HammonFitPart, hammon_fit_bins, single_scattering_bins};
 use crate::output::{case_fields, write_atomically};
@@ -200,19 +200,13 @@ fn predict(
             let options = RunOptions { estimator, shard: Shard::WHOLE, threads, show_progress: true };
             let sim = crate::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))?;
             for_each_lobe(&sim, &mut |case, order, hemisphere, channel, value| {
-                if model != Model::ExactPositionFree || position_free_applies(case) {
+                if model != Model::ExactPositionFree || case.position_free_applies() {
                     rows(case, order, hemisphere, channel, value, &mut out)
                 }
             });
         }
     }
     Ok(out)
-}
-
-/// Whether the exact position-free form (§7.1) describes a case's walk: facets that reflect on
-/// one side, the true Smith Lambda and visible normals (the chain's own laws).
-fn position_free_applies(case: &crate::cases::Case) -> bool {
-    !case.material.transmits() && case.smith == SmithKind::Exact && case.normals == NormalsKind::Vndf
 }
 
 type LobeVisitor<'a> = dyn FnMut(&crate::cases::Case, usize, Hemisphere, &str, &mut dyn FnMut(usize) -> Value) + 'a;

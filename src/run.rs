@@ -59,8 +59,8 @@ pub enum Estimator {
     /// Next-event estimation along the walk (Heitz et al. 2016 `eval`, §4.7), with this many
     /// outgoing directions per hit.
     HeitzNee(u32),
-    /// The exact position-free chain (§7.1). It holds for facets that reflect on one side:
-    /// cases whose material transmits are skipped (their photons deposit nothing).
+    /// The exact position-free chain (§7.1). Cases it does not describe
+    /// ([`Case::position_free_applies`]) are skipped: their photons deposit nothing.
     PositionFree,
 }
 
@@ -254,7 +254,7 @@ where
                 Estimator::Wang(mut shadowing) => {
                     chain::trace(&mut shadowing, &w.surface.ndf, &w.facet, policy, wi, &mut rng, detector)
                 }
-                Estimator::PositionFree if w.case.material.transmits() => 0,
+                Estimator::PositionFree if !w.case.position_free_applies() => 0,
                 Estimator::PositionFree => {
                     chain::trace(&mut profile, &w.surface.ndf, &w.facet, policy, wi, &mut rng, detector)
                 }

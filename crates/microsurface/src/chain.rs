@@ -23,11 +23,11 @@ pub trait Visibility {
     /// Starts a photon that enters along a direction of depth rate `rate` (§2.4).
     fn enter(&mut self, rate: f64);
 
-    /// The fraction of the chain's weight that escapes when it leaves a vertex along `d`
-    /// (unit, in the frame of the side it leaves into), having arrived along a direction of
-    /// depth rate `rate_in`; `refracted` tells whether the vertex changed side. A direction
-    /// into the surface escapes nothing.
-    fn leave<N: Ndf>(&mut self, ndf: &N, rate_in: f64, d: DVec3, refracted: bool) -> f64;
+    /// The fraction of the chain's weight that escapes when it leaves a vertex along a
+    /// direction of depth rate `rate_out`, pointing away from the surface on its side (`up`)
+    /// or into it, having arrived along a direction of depth rate `rate_in`; `refracted` tells
+    /// whether the vertex changed side. A direction into the surface escapes nothing.
+    fn leave(&mut self, rate_in: f64, rate_out: f64, up: bool, refracted: bool) -> f64;
 }
 
 /// Walks one photon arriving from `wi` (towards the light) through the chain with `visibility`
@@ -56,10 +56,12 @@ where
     let mut order = 0u32;
     // The own-side frame (§4.3): inside, directions are flipped.
     let flip = |v: DVec3, s: Side| if s == Side::Outside { v } else { -v };
-    visibility.enter(Smith::Exact.rate(ndf, flip(d, side)));
+    // Depth rate of the arriving direction (true Smith, §2.4); each leaving direction's rate
+    // is the next vertex's arriving one.
+    let mut rate_in = Smith::Exact.rate(ndf, flip(d, side));
+    visibility.enter(rate_in);
     loop {
         let d_own = flip(d, side);
-        let rate_in = Smith::Exact.rate(ndf, d_own);
         let m = flip(ndf.sample_visible(-d_own, rng), side);
         order += 1;
         if order >= RUNAWAY_ORDER {
@@ -80,7 +82,10 @@ where
             side = side.other();
         }
         d = branch.dir;
-        let p = visibility.leave(ndf, rate_in, flip(d, side), branch.crosses);
+        let d_out = flip(d, side);
+        let rate_out = Smith::Exact.rate(ndf, d_out);
+        let p = visibility.leave(rate_in, rate_out, d_out.z > 0.0, branch.crosses);
+        rate_in = rate_out;
         if !d.is_finite() || !p.is_finite() || weight.iter().any(|w| !w.is_finite()) {
             observer.lose(Loss::Invalid, &weight);
             return u64::from(order);

@@ -23,11 +23,7 @@
 //! Dielectrics do not collapse to one slab (the depth coordinates of the two sides differ);
 //! a refraction gives NaN, which the chain reports as an invalid loss.
 
-use glam::DVec3;
-
 use crate::chain::Visibility;
-use crate::ndf::Ndf;
-use crate::smith::Smith;
 
 /// Rates closer than this (relative) are separated before a downward step divides by their
 /// difference (§7.1, numerics); the perturbation is far below any statistical error.
@@ -98,12 +94,11 @@ impl Visibility for DepthProfile {
         self.terms.push((rate, rate));
     }
 
-    fn leave<N: Ndf>(&mut self, ndf: &N, _rate_in: f64, d: DVec3, refracted: bool) -> f64 {
+    fn leave(&mut self, _rate_in: f64, lambda: f64, up: bool, refracted: bool) -> f64 {
         if refracted {
             return f64::NAN;
         }
-        let lambda = Smith::Exact.rate(ndf, d);
-        if d.z > 0.0 {
+        if up {
             self.up(lambda)
         } else {
             self.down(lambda);

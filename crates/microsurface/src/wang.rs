@@ -12,11 +12,9 @@
 //! and a direction into the surface continues with probability 1. Both variants conserve
 //! energy exactly, and the correlated one reproduces exact single scattering (§6.3).
 
-use glam::DVec3;
 use statrs::function::gamma::ln_gamma;
 
 use crate::chain::Visibility;
-use crate::ndf::Ndf;
 
 /// The shadowing model of the chain (§6.3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,13 +34,13 @@ impl Visibility for Shadowing {
     /// Wang's models forget the path: nothing to start.
     fn enter(&mut self, _rate: f64) {}
 
-    /// The local escape probability of a direction `d` leaving a vertex reached along a
-    /// direction of depth rate `rate_in` (§6.3); 0 into the surface.
-    fn leave<N: Ndf>(&mut self, ndf: &N, rate_in: f64, d: DVec3, refracted: bool) -> f64 {
-        if d.z <= 0.0 {
+    /// The local escape probability of a direction leaving a vertex reached along a direction
+    /// of depth rate `rate_in` (§6.3); 0 into the surface. Upwards, the leaving direction's
+    /// depth rate is its `Lambda`.
+    fn leave(&mut self, rate_in: f64, lambda_out: f64, up: bool, refracted: bool) -> f64 {
+        if !up {
             return 0.0;
         }
-        let lambda_out = ndf.lambda(d);
         match (self, refracted) {
             (Shadowing::Uncorrelated, _) => 1.0 / (1.0 + lambda_out),
             (Shadowing::Correlated, false) => rate_in / (rate_in + lambda_out),
