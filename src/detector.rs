@@ -18,12 +18,6 @@ pub struct Fixed(i128);
 const FIXED_ONE: f64 = 18_446_744_073_709_551_616.0; // 2^64
 
 impl Fixed {
-    /// Adds a finite, non-negative value below 2^62.
-    #[inline]
-    pub fn add(&mut self, x: f64) {
-        self.0 += to_fixed(x);
-    }
-
     pub fn to_f64(self) -> f64 {
         self.0 as f64 / FIXED_ONE
     }
@@ -88,13 +82,33 @@ impl<const C: usize> Default for Tally<C> {
     }
 }
 
+/// One photon's contribution to a tally in fixed point: per channel, the weight and its square.
+/// Converted once, it can be added to every tally the photon reaches.
+#[derive(Clone, Copy, Debug)]
+struct Contribution<const C: usize> {
+    sum: [i128; C],
+    sum_sq: [i128; C],
+}
+
+impl<const C: usize> Contribution<C> {
+    #[inline]
+    fn of(w: &[f64; C]) -> Self {
+        Self { sum: w.map(to_fixed), sum_sq: w.map(|x| to_fixed(x * x)) }
+    }
+}
+
 impl<const C: usize> Tally<C> {
     /// Adds one photon's total contribution.
     #[inline]
     pub fn add(&mut self, w: &[f64; C]) {
-        for ((sum, sum_sq), &x) in self.sum.iter_mut().zip(&mut self.sum_sq).zip(w) {
-            sum.add(x);
-            sum_sq.add(x * x);
+        self.add_contribution(&Contribution::of(w));
+    }
+
+    #[inline]
+    fn add_contribution(&mut self, c: &Contribution<C>) {
+        for i in 0..C {
+            self.sum[i].0 += c.sum[i];
+            self.sum_sq[i].0 += c.sum_sq[i];
         }
         self.count += 1;
     }
@@ -362,6 +376,24 @@ impl<const C: usize> Detector<C> {
     pub fn end_photon(&mut self, interactions: u64) {
         self.tallies.photons += 1;
         self.tallies.interactions += interactions;
+        let needed = self.pending.iter().map(|d| d.slot).max().unwrap_or(0) + 1;
+        if self.tallies.orders.len() < needed {
+            self.tallies.orders.resize_with(needed, || OrderTallies::empty(2 * self.grid.bins()));
+        }
+        match (&self.pending[..], self.any_loss) {
+            // The common case: the whole weight escaped at once, so one conversion to fixed
+            // point serves the accounted total and the photon's bin and albedo tallies.
+            (&[d], false) => {
+                let c = Contribution::of(&d.weight);
+                self.tallies.accounted.add_contribution(&c);
+                self.add_to_orders(&d, &c);
+            }
+            _ => self.add_photon_with_losses_or_splits(),
+        }
+        self.pending.clear();
+    }
+
+    fn add_photon_with_losses_or_splits(&mut self) {
         let mut total = [0.0; C];
         for d in &self.pending {
             accumulate(&mut total, &d.weight);
@@ -375,22 +407,22 @@ impl<const C: usize> Detector<C> {
             self.any_loss = false;
         }
         self.tallies.accounted.add(&total);
-        let needed = self.pending.iter().map(|d| d.slot).max().unwrap_or(0) + 1;
-        while self.tallies.orders.len() < needed {
-            self.tallies.orders.push(OrderTallies::empty(2 * self.grid.bins()));
-        }
-        let bins = self.grid.bins();
         if let [d] = self.pending[..] {
-            let i = d.hemisphere as usize * bins + d.bin;
-            for slot in [0, d.slot] {
-                let o = &mut self.tallies.orders[slot];
-                o.bins[i].add(&d.weight);
-                o.albedo[d.hemisphere as usize].add(&d.weight);
-            }
+            self.add_to_orders(&d, &Contribution::of(&d.weight));
         } else if !self.pending.is_empty() {
             self.add_split_photon();
         }
-        self.pending.clear();
+    }
+
+    /// Adds a photon's only deposit to its bin and albedo in slot 0 (all orders) and in its own slot.
+    #[inline]
+    fn add_to_orders(&mut self, d: &Deposit<C>, c: &Contribution<C>) {
+        let i = d.hemisphere as usize * self.grid.bins() + d.bin;
+        for slot in [0, d.slot] {
+            let o = &mut self.tallies.orders[slot];
+            o.bins[i].add_contribution(c);
+            o.albedo[d.hemisphere as usize].add_contribution(c);
+        }
     }
 
     /// A photon that was split deposits several times: sum its deposits per (slot, bin) and
