@@ -36,6 +36,14 @@ pub struct Throughput {
 }
 
 impl Throughput {
+    /// The faster of this measurement and `other`.
+    pub fn fastest(self, other: Option<Throughput>) -> Throughput {
+        match other {
+            Some(o) if o.paths_per_second > self.paths_per_second => o,
+            _ => self,
+        }
+    }
+
     pub fn per_core(&self) -> f64 {
         self.paths_per_second / self.threads as f64
     }
