@@ -255,7 +255,10 @@ fn diamond_angle(x: f64, y: f64) -> f64 {
         return 0.0;
     }
     let t = x / l1;
-    if y >= 0.0 { 1.0 - t } else { 3.0 + t }
+    // `1 - t` for y >= 0, else `3 + t`, without a branch: the sign of y is as likely as not,
+    // so a branch would be mispredicted for half the escapes. Both forms are exact.
+    let lower = f64::from(u8::from(y < 0.0));
+    (1.0 + 2.0 * lower) + (2.0 * lower - 1.0) * t
 }
 
 /// Bins escaping directions: |cos theta| directly, and the azimuth relative to the incident
