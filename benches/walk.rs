@@ -12,7 +12,7 @@ fn main() {
 
 #[divan::bench(args = 0..CASES.len(), sample_count = 10)]
 fn walk(bencher: divan::Bencher, case: usize) {
-    let config = case_config(case, PATHS);
+    let config = case_config(case, PATHS).expect("the reference cases allow PATHS photons");
     bencher
         .counter(divan::counter::ItemsCount::new(PATHS))
         .bench(|| smithwalk::simulate(divan::black_box(&config), Some(1), false).expect("runs"));

@@ -20,11 +20,12 @@ pub const CASES: [(&str, &str, f64); 5] = [
     ("beckmann conductor F=1 a=0.5 60deg", "ndf = \"beckmann\"\nalpha = 0.5\n[material]\nkind = \"conductor\"", 60.0),
 ];
 
-/// The run configuration of a reference case with `paths` photons and the default detector.
-pub fn case_config(case: usize, paths: u64) -> Config {
+/// The run configuration of a reference case with `paths` photons and the default detector;
+/// an error if the run configuration does not allow that many photons.
+pub fn case_config(case: usize, paths: u64) -> Result<Config> {
     let (_, surface, theta) = CASES[case];
     let toml = format!("paths = {paths}\nseed = 1\n[surface]\n{surface}\n[incident]\ntheta_deg = {theta}\n");
-    Config::parse(&toml).expect("reference cases are valid")
+    Ok(Config::parse(&toml)?)
 }
 
 /// One measurement: throughput on `threads` threads.
@@ -56,7 +57,7 @@ impl Throughput {
 
 /// Runs a reference case on `threads` threads.
 pub fn measure(case: usize, paths: u64, threads: usize) -> Result<Throughput> {
-    let config = case_config(case, paths);
+    let config = case_config(case, paths)?;
     let sim = simulate(&config, Some(threads), false)?;
     let interactions = match &sim.results[0] {
         crate::run::CaseResult::Mono(d) => d.tallies.interactions,

@@ -143,6 +143,8 @@ enum Command {
 
 fn bench(paths: u64, repeats: usize) -> Result<()> {
     use smithwalk::bench::{CASES, Throughput, measure};
+    // The reference configurations with this photon count are checked before the table starts.
+    smithwalk::bench::case_config(0, paths)?;
     if repeats == 0 {
         bail!("`--repeats` = 0 is not allowed: at least 1 measurement per case");
     }

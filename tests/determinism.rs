@@ -170,3 +170,21 @@ fn sweeps_parse_unambiguously_and_round_trip() {
     assert_eq!(parse("[0.1, [1.0, 0.1]]"), vec![Alpha::Isotropic(0.1), Alpha::Anisotropic([1.0, 0.1])]);
     assert!(matches!(Config::parse(GOOD).unwrap().surface.alpha, OneOrMany::One(_)));
 }
+
+#[test]
+fn bench_rejects_bad_counts_with_a_clear_error_and_no_table() {
+    for (args, expect) in [
+        (["--paths", "0", "--repeats", "1"], ["`paths` = 0", "at least 2"]),
+        (["--paths", "1", "--repeats", "1"], ["`paths` = 1", "at least 2"]),
+        (["--paths", "100", "--repeats", "0"], ["`--repeats` = 0", "at least 1"]),
+    ] {
+        let result = smithwalk(&[&["bench"][..], &args].concat());
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        assert_eq!(result.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        for e in expect {
+            assert!(stderr.contains(e), "{args:?}: error {stderr:?} does not mention {e:?}");
+        }
+        assert!(result.stdout.is_empty(), "{args:?}: a table was started");
+    }
+}
