@@ -415,10 +415,10 @@ impl PrecisionConfig {
         let targets =
             [("precision.target_rel_stderr", self.target_rel_stderr), ("precision.target_stderr", self.target_stderr)];
         for (field, target) in targets {
-            if let Some(t) = target {
-                if !(t.is_finite() && t > 0.0) {
-                    return Err(invalid(field, t, "a standard error > 0"));
-                }
+            if let Some(t) = target
+                && !(t.is_finite() && t > 0.0)
+            {
+                return Err(invalid(field, t, "a standard error > 0"));
             }
         }
         Ok(())
@@ -520,14 +520,14 @@ impl Config {
             }
         }
         non_empty("incident.side", &i.side)?;
-        if i.side.values().contains(&IncidentSide::Inside) {
-            if let Some(m) = materials.iter().find(|m| !m.transmits()) {
-                return Err(invalid(
-                    "incident.side",
-                    "\"inside\"",
-                    format!("light from inside needs dielectric materials only, but a material is {}", m.kind()),
-                ));
-            }
+        if i.side.values().contains(&IncidentSide::Inside)
+            && let Some(m) = materials.iter().find(|m| !m.transmits())
+        {
+            return Err(invalid(
+                "incident.side",
+                "\"inside\"",
+                format!("light from inside needs dielectric materials only, but a material is {}", m.kind()),
+            ));
         }
         let d = &self.detector;
         if d.cos_theta_bins == 0 || d.cos_theta_bins > 4096 {

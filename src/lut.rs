@@ -144,10 +144,10 @@ impl LutConfig {
     pub fn validate(&self) -> Result<(), ConfigError> {
         let counts = [("mu", self.mu), ("alpha", self.alpha), ("eta", self.eta)];
         for (field, n) in counts {
-            if let Some(n) = n {
-                if !(1..=1024).contains(&n) {
-                    return Err(invalid(field, n, "a node count from 1 to 1024"));
-                }
+            if let Some(n) = n
+                && !(1..=1024).contains(&n)
+            {
+                return Err(invalid(field, n, "a node count from 1 to 1024"));
             }
         }
         if self.eta.is_some() && !self.is_dielectric() {
@@ -180,10 +180,10 @@ impl LutConfig {
         if !(2..=256).contains(&self.avg_nodes) {
             return Err(invalid("avg_nodes", self.avg_nodes, "a node count from 2 to 256"));
         }
-        if let Some(t) = self.target_stderr {
-            if !(t.is_finite() && t > 0.0) {
-                return Err(invalid("target_stderr", t, "a standard error > 0"));
-            }
+        if let Some(t) = self.target_stderr
+            && !(t.is_finite() && t > 0.0)
+        {
+            return Err(invalid("target_stderr", t, "a standard error > 0"));
         }
         self.run_config().validate()
     }

@@ -302,10 +302,10 @@ fn merge(shards: &[PathBuf], out: &Path) -> Result<()> {
 
 /// Prints the end summary; a closed pipe (`| head`) is not an error, the outputs are written.
 fn report(sim: &Simulation, config: &Config, written: &[PathBuf]) -> Result<()> {
-    if let Err(e) = print_summary(sim, config, written) {
-        if e.kind() != std::io::ErrorKind::BrokenPipe {
-            return Err(e.into());
-        }
+    if let Err(e) = print_summary(sim, config, written)
+        && e.kind() != std::io::ErrorKind::BrokenPipe
+    {
+        return Err(e.into());
     }
     Ok(())
 }

@@ -163,10 +163,11 @@ pub fn two_sample_at_null(a: &[WeightedBin], n1: u64, b: &[WeightedBin], n2: u64
         }
     }
     let mu = common_mean(&pool_a, &pool_b);
-    if !pool_bins.is_empty() && expected_count(mu) >= min_count {
-        if let Some(z) = z(&pool_a, &pool_b, mu) {
-            cells.push(Cell { bins: pool_bins, observed: pool_a.mean, expected: pool_b.mean, z });
-        }
+    if !pool_bins.is_empty()
+        && expected_count(mu) >= min_count
+        && let Some(z) = z(&pool_a, &pool_b, mu)
+    {
+        cells.push(Cell { bins: pool_bins, observed: pool_a.mean, expected: pool_b.mean, z });
     }
     ChiSquare::from_cells(cells)
 }
