@@ -374,28 +374,6 @@ impl<const C: usize> Detector<C> {
         self.max_order.is_some_and(|k| slot == k as usize)
     }
 
-    /// Closes the current photon, which made `interactions` facet interactions: adds its
-    /// per-bin, per-order and total contributions.
-    pub fn end_photon(&mut self, interactions: u64) {
-        self.tallies.photons += 1;
-        self.tallies.interactions += interactions;
-        let needed = self.pending.iter().map(|d| d.slot).max().unwrap_or(0) + 1;
-        if self.tallies.orders.len() < needed {
-            self.tallies.orders.resize_with(needed, || OrderTallies::empty(2 * self.grid.bins()));
-        }
-        match (&self.pending[..], self.any_loss) {
-            // The common case: the whole weight escaped at once, so one conversion to fixed
-            // point serves the accounted total and the photon's bin and albedo tallies.
-            (&[d], false) => {
-                let c = Contribution::of(&d.weight);
-                self.tallies.accounted.add_contribution(&c);
-                self.add_to_orders(&d, &c);
-            }
-            _ => self.add_photon_with_losses_or_splits(),
-        }
-        self.pending.clear();
-    }
-
     fn add_photon_with_losses_or_splits(&mut self) {
         let mut total = [0.0; C];
         for d in &self.pending {
@@ -415,6 +393,33 @@ impl<const C: usize> Detector<C> {
         } else if !self.pending.is_empty() {
             self.add_split_photon();
         }
+    }
+
+    /// Where an escape deposits its weight.
+    #[inline]
+    fn deposit(&self, order: u32, side: Side, dir: DVec3, weight: &[f64; C]) -> Deposit<C> {
+        let hemisphere = if side == self.incident_side { Hemisphere::R } else { Hemisphere::T };
+        Deposit { slot: self.slot(order), hemisphere, bin: self.binner.bin(dir), weight: *weight }
+    }
+
+    /// Counts a finished photon that made `interactions` facet interactions and whose highest
+    /// order slot is `slot`.
+    #[inline]
+    fn count_photon(&mut self, interactions: u64, slot: usize) {
+        self.tallies.photons += 1;
+        self.tallies.interactions += interactions;
+        if self.tallies.orders.len() <= slot {
+            self.tallies.orders.resize_with(slot + 1, || OrderTallies::empty(2 * self.grid.bins()));
+        }
+    }
+
+    /// Adds a photon whose whole weight escaped at once, in deposit `d`: one conversion to
+    /// fixed point serves the accounted total and the photon's bin and albedo tallies.
+    #[inline]
+    fn add_whole_photon(&mut self, d: &Deposit<C>) {
+        let c = Contribution::of(&d.weight);
+        self.tallies.accounted.add_contribution(&c);
+        self.add_to_orders(d, &c);
     }
 
     /// Adds a photon's only deposit to its bin and albedo in slot 0 (all orders) and in its own slot.
@@ -465,14 +470,31 @@ impl<const C: usize> Detector<C> {
 impl<const C: usize> Observer<C> for Detector<C> {
     #[inline]
     fn escape(&mut self, order: u32, side: Side, dir: DVec3, weight: &[f64; C]) {
-        let hemisphere = if side == self.incident_side { Hemisphere::R } else { Hemisphere::T };
-        let bin = self.binner.bin(dir);
-        self.pending.push(Deposit { slot: self.slot(order), hemisphere, bin, weight: *weight });
+        let d = self.deposit(order, side, dir, weight);
+        self.pending.push(d);
     }
 
     fn lose(&mut self, loss: Loss, weight: &[f64; C]) {
         accumulate(&mut self.pending_loss[loss_index(loss)], weight);
         self.any_loss = true;
+    }
+
+    /// Closes the current photon, which made `interactions` facet interactions: adds its
+    /// per-bin, per-order and total contributions.
+    fn end_photon(&mut self, interactions: u64) {
+        self.count_photon(interactions, self.pending.iter().map(|d| d.slot).max().unwrap_or(0));
+        match (&self.pending[..], self.any_loss) {
+            (&[d], false) => self.add_whole_photon(&d),
+            _ => self.add_photon_with_losses_or_splits(),
+        }
+        self.pending.clear();
+    }
+
+    #[inline]
+    fn escape_photon(&mut self, order: u32, side: Side, dir: DVec3, weight: &[f64; C]) {
+        let d = self.deposit(order, side, dir, weight);
+        self.count_photon(u64::from(order), d.slot);
+        self.add_whole_photon(&d);
     }
 }
 

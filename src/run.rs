@@ -12,7 +12,7 @@ use microsurface::nee::NextEvent;
 use microsurface::normals::Normals;
 use microsurface::position_free::DepthProfile;
 use microsurface::smith::Smith;
-use microsurface::walk::{EnergyPolicy, Microsurface};
+use microsurface::walk::{EnergyPolicy, Microsurface, Observer};
 use microsurface::wang::Shadowing;
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
@@ -228,6 +228,18 @@ struct Walker<'a, N, F> {
     settings: &'a RunSettings,
 }
 
+impl<N: Ndf, F> Walker<'_, N, F> {
+    /// Whether the measurement walks photons side by side
+    /// ([`Microsurface::walk_side_by_side`]): when its paths never split. Part of the output's
+    /// identity, like [`CHUNK`]: the two ways draw random numbers in different orders.
+    fn side_by_side<const C: usize>(&self) -> bool
+    where
+        F: Facet<C>,
+    {
+        !(self.settings.policy.split && self.facet.may_split())
+    }
+}
+
 impl<N, F, const C: usize> CaseWalker for (Walker<'_, N, F>, [(); C])
 where
     N: Ndf,
@@ -248,7 +260,12 @@ where
         let policy = &w.settings.policy;
         let mut nee_rng = chunk_rng(w.settings.seed ^ NEE_STREAMS, w.case.index, chunk);
         let mut profile = DepthProfile::default();
-        for _ in 0..w.settings.chunk_photons(chunk) {
+        let photons = w.settings.chunk_photons(chunk);
+        if w.settings.estimator == Estimator::Walk && w.side_by_side() {
+            w.surface.walk_side_by_side(&w.facet, policy, wi, photons, &mut rng, detector);
+            return;
+        }
+        for _ in 0..photons {
             let interactions = match w.settings.estimator {
                 Estimator::Walk => w.surface.trace(&w.facet, policy, wi, &mut rng, &mut stack, detector),
                 Estimator::Wang(mut shadowing) => {

@@ -29,6 +29,16 @@ impl Side {
             Side::Inside => Side::Outside,
         }
     }
+
+    /// A direction in the frame of this side (§4.3): unchanged outside, negated (flipped)
+    /// inside.
+    #[inline]
+    pub fn frame(self, d: DVec3) -> DVec3 {
+        match self {
+            Side::Outside => d,
+            Side::Inside => -d,
+        }
+    }
 }
 
 /// One outcome of a facet interaction.
@@ -56,6 +66,9 @@ pub trait Facet<const C: usize>: Send + Sync {
     /// The interaction of light arriving from `w` (pointing away from the facet) with a facet
     /// of normal `m`, `w·m > 0`, on `side` of the surface.
     fn interact<R: Rng + ?Sized>(&self, w: DVec3, m: DVec3, side: Side, rng: &mut R) -> Interaction<C>;
+
+    /// Whether [`Facet::interact`] may return two branches.
+    fn may_split(&self) -> bool;
 
     /// The phase function of the microsurface's hit facets (§4.2–§4.5): the density, per unit
     /// solid angle of the new travel direction `d`, of leaving a hit with incident direction
@@ -131,6 +144,10 @@ impl<const C: usize> Facet<C> for Conductor<C> {
         Interaction::One(Branch { dir: reflect(w, m), weight, crosses: false })
     }
 
+    fn may_split(&self) -> bool {
+        false
+    }
+
     fn phase<N: Ndf, R: Rng + ?Sized>(
         &self,
         ndf: &N,
@@ -176,6 +193,10 @@ impl<const C: usize> Facet<C> for Dielectric {
             ),
             _ => Interaction::One(reflected),
         }
+    }
+
+    fn may_split(&self) -> bool {
+        true
     }
 
     fn phase<N: Ndf, R: Rng + ?Sized>(
@@ -226,6 +247,10 @@ impl<const C: usize> Facet<C> for Lambertian<C> {
         Interaction::One(Branch { dir, weight: self.albedo, crosses: false })
     }
 
+    fn may_split(&self) -> bool {
+        false
+    }
+
     fn phase<N: Ndf, R: Rng + ?Sized>(
         &self,
         ndf: &N,
@@ -259,6 +284,10 @@ impl<const C: usize> Facet<C> for Hammon<C> {
         let dir = about_normal(m, cos_theta, unit_circle(rng));
         let weight = std::array::from_fn(|i| (1.0 - f[i]) * self.albedo[i]);
         Interaction::Two(specular, Branch { dir, weight, crosses: false })
+    }
+
+    fn may_split(&self) -> bool {
+        true
     }
 
     fn phase<N: Ndf, R: Rng + ?Sized>(

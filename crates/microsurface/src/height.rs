@@ -7,13 +7,15 @@
 //! gives bit-identical walks. (Heights on [-1, 1] would cap the representable depth at about
 //! 37, which Hammon's symmetric Lambda exceeds routinely, §2.7.)
 
-/// Where a free flight ends (§2.3).
+/// Where a free flight ends (§2.3): out of the microsurface, or at a facet at depth `tau`
+/// (meaningless for an escape). A pair rather than a choice, so that a walk can act on it
+/// without a branch.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Flight {
+pub struct Flight {
     /// The ray leaves the microsurface.
-    Escape,
-    /// The ray hits a facet at this optical depth.
-    Hit(f64),
+    pub escapes: bool,
+    /// The optical depth of the facet hit, if it does not.
+    pub tau: f64,
 }
 
 /// One free flight from optical depth `tau` (on the ray's own side) for a ray travelling up
@@ -23,11 +25,9 @@ pub enum Flight {
 #[inline]
 pub fn fly(tau: f64, up: bool, rate: f64, e: f64) -> Flight {
     let travelled = e / rate;
-    if up {
-        if travelled > tau { Flight::Escape } else { Flight::Hit(tau - travelled) }
-    } else {
-        Flight::Hit(tau + travelled)
-    }
+    // Whether a ray goes up is a coin toss for the branch predictor: select, do not branch.
+    let tau_hit = std::hint::select_unpredictable(up, tau - travelled, tau + travelled);
+    Flight { escapes: up && travelled > tau, tau: tau_hit }
 }
 
 /// The optical depth of the same point seen from the other side of the heightfield (§4.3):

@@ -68,6 +68,14 @@ pub trait Ndf: Copy + Send + Sync {
     /// exactly, for any `w` on the sphere except `-z` (where `A = 0`; then it returns `+z`).
     fn sample_visible<R: Rng + ?Sized>(&self, w: DVec3, rng: &mut R) -> DVec3;
 
+    /// [`Ndf::sample_visible`] for `L` directions at once, for walks of photons side by side.
+    /// An NDF whose sampler is a fixed computation on its random numbers draws them all first,
+    /// so that the `L` computations are independent and overlap.
+    #[inline]
+    fn sample_visible_lanes<R: Rng + ?Sized, const L: usize>(&self, w: [DVec3; L], rng: &mut R) -> [DVec3; L] {
+        w.map(|w| self.sample_visible(w, rng))
+    }
+
     /// Slope radius `r = tan(theta_m)` of a normal drawn from `D(m) m_z` in the roughness-1
     /// configuration, as a function of a uniform `u` (the inverse of [`Ndf::std_slope_cdf`]).
     fn std_slope_radius(u: f64) -> f64;
@@ -118,12 +126,15 @@ impl Ndf for Ggx {
 
     /// Dupuy & Benyoub 2023 spherical caps (§3.2), exact on the full sphere.
     fn sample_visible<R: Rng + ?Sized>(&self, w: DVec3, rng: &mut R) -> DVec3 {
-        let ws = self.0.stretch(w);
-        let (c, s) = unit_circle(rng);
-        let z = (1.0 - open01(rng)) * (1.0 + ws.z) - ws.z;
-        let sin_theta = (1.0 - z * z).max(0.0).sqrt();
-        let h = DVec3::new(sin_theta * c, sin_theta * s, z) + ws;
-        self.0.unstretch_normal(DVec3::new(h.x, h.y, h.z.max(0.0)))
+        let azimuth = unit_circle(rng);
+        self.cap_sample(w, azimuth, open01(rng))
+    }
+
+    #[inline]
+    fn sample_visible_lanes<R: Rng + ?Sized, const L: usize>(&self, w: [DVec3; L], rng: &mut R) -> [DVec3; L] {
+        let azimuths: [(f64, f64); L] = std::array::from_fn(|_| unit_circle(rng));
+        let heights: [f64; L] = std::array::from_fn(|_| open01(rng));
+        std::array::from_fn(|i| self.cap_sample(w[i], azimuths[i], heights[i]))
     }
 
     /// `cos^2 theta = 1 - u` for roughness 1 ([Ham17], "Intersection normal"), so `tan^2 = u / (1 - u)`.
@@ -134,6 +145,21 @@ impl Ndf for Ggx {
     fn std_slope_cdf(r: f64) -> f64 {
         let r2 = r * r;
         if r2.is_infinite() { 1.0 } else { r2 / (1.0 + r2) }
+    }
+}
+
+impl Ggx {
+    /// The visible normal of `w` for the random azimuth `(cos phi, sin phi)` and uniform `u`
+    /// (§3.2): in the stretched configuration, the point of the spherical cap
+    /// `z in (-w'_z, 1]` at height `z = (1 - u)(1 + w'_z) - w'_z` and azimuth phi, plus `w'`,
+    /// is the half vector; unstretched, the normal.
+    #[inline]
+    fn cap_sample(&self, w: DVec3, (c, s): (f64, f64), u: f64) -> DVec3 {
+        let ws = self.0.stretch(w);
+        let z = (1.0 - u) * (1.0 + ws.z) - ws.z;
+        let sin_theta = (1.0 - z * z).max(0.0).sqrt();
+        let h = DVec3::new(sin_theta * c, sin_theta * s, z) + ws;
+        self.0.unstretch_normal(DVec3::new(h.x, h.y, h.z.max(0.0)))
     }
 }
 

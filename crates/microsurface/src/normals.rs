@@ -29,6 +29,21 @@ impl Normals {
             Normals::HammonRejection => hammon_rejection(ndf, d, rng),
         }
     }
+
+    /// Draws the normals of the facets hit by `L` rays at once (travelling along `d`), each
+    /// with the law of [`Normals::sample`]; the order of the draws is the sampler's own.
+    #[inline]
+    pub fn sample_lanes<N: Ndf, R: Rng + ?Sized, const L: usize>(
+        self,
+        ndf: &N,
+        d: [DVec3; L],
+        rng: &mut R,
+    ) -> [DVec3; L] {
+        match self {
+            Normals::Visible => ndf.sample_visible_lanes(d.map(|d| -d), rng),
+            Normals::HammonRejection => d.map(|d| hammon_rejection(ndf, d, rng)),
+        }
+    }
 }
 
 /// Hammon's sampler, step by step as the seed gives it, run in the stretched roughness-1

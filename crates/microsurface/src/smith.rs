@@ -22,15 +22,14 @@ impl Smith {
     /// `Lambda(-d)` downward with Hammon's variant (§2.7). `+inf` for horizontal travel.
     #[inline]
     pub fn rate<N: Ndf>(self, ndf: &N, d: DVec3) -> f64 {
-        if d.z > 0.0 {
-            ndf.lambda(d)
-        } else if d.z < 0.0 {
-            match self {
-                Smith::Exact => 1.0 + ndf.lambda(-d),
-                Smith::Symmetric => ndf.lambda(-d),
-            }
-        } else {
-            f64::INFINITY
+        // `Lambda(-d)` of a downward ray is `Lambda` of its mirror image in the horizon (Lambda
+        // depends on the azimuth only through squares), so both cases evaluate Lambda above
+        // the horizon and the exact variant adds 1 downward: no branch on the direction,
+        // whose sign the walk cannot predict.
+        let above = ndf.lambda(DVec3::new(d.x, d.y, d.z.abs()));
+        match self {
+            Smith::Exact => above + f64::from(u8::from(d.z < 0.0)),
+            Smith::Symmetric => above,
         }
     }
 }

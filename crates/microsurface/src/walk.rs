@@ -6,6 +6,8 @@
 //! direction is negated and its depth is measured from below, which turns it into an outside
 //! problem; a refraction converts the depth to the other side.
 
+use std::hint::select_unpredictable;
+
 use glam::DVec3;
 use rand::Rng;
 
@@ -63,6 +65,16 @@ pub trait Observer<const C: usize> {
     /// A ray hits its `order`-th facet at optical depth `tau` on `side`, travelling along `d`
     /// with `weight`, before the facet acts (for next-event estimation, §4.7).
     fn hit(&mut self, _order: u32, _tau: f64, _side: Side, _d: DVec3, _weight: &[f64; C]) {}
+    /// The photon whose escapes and losses were reported since the last call is complete; its
+    /// rays made `interactions` facet interactions in all. ([`Microsurface::walk_side_by_side`]
+    /// reports it; callers of [`Microsurface::trace`] close photons themselves.)
+    fn end_photon(&mut self, _interactions: u64) {}
+    /// A whole photon escapes at once: its only ray, with no loss before, after `order` facet
+    /// interactions. The same as [`Observer::escape`] then [`Observer::end_photon`].
+    fn escape_photon(&mut self, order: u32, side: Side, dir: DVec3, weight: &[f64; C]) {
+        self.escape(order, side, dir, weight);
+        self.end_photon(u64::from(order));
+    }
 }
 
 /// A ray of the walk: optical depth on its own side, travel direction, side, weight and
@@ -113,6 +125,90 @@ impl<N: Ndf> Microsurface<N> {
         interactions
     }
 
+    /// Walks `photons` photons arriving from `wi`, [`LANES`] at a time side by side, and
+    /// reports each one's escape or loss to `observer`, followed by its end
+    /// ([`Observer::end_photon`]). Each photon is walked exactly as by [`Microsurface::trace`];
+    /// what differs is the order in which the photons draw their random numbers.
+    ///
+    /// Why: one photon is a chain of dependent square roots and divisions, and whether a
+    /// flight escapes is a coin toss that ends the chain. Side by side, the chains of several
+    /// photons overlap, and an escape does not branch: it is recorded into a buffer and its lane
+    /// is refilled with the next photon (whose first flight, downward from depth 0, always
+    /// hits) by selection. The buffer is handed to `observer` when it fills.
+    ///
+    /// Only for paths that never split: a facet with two branches must be walked with
+    /// `policy.split` off (a random choice, §4.6). Panics otherwise.
+    pub fn walk_side_by_side<F, R, O, const C: usize>(
+        &self,
+        facet: &F,
+        policy: &EnergyPolicy,
+        wi: DVec3,
+        photons: u64,
+        rng: &mut R,
+        observer: &mut O,
+    ) where
+        F: Facet<C>,
+        R: Rng + ?Sized,
+        O: Observer<C>,
+    {
+        assert!(!(policy.split && facet.may_split()), "walk_side_by_side cannot split paths");
+        let side = if wi.z >= 0.0 { Side::Outside } else { Side::Inside };
+        let fresh = Ray { tau: 0.0, d: -wi, side, beta: [1.0; C], order: 0 };
+        // The first flight, downward from depth 0, always hits: at depth `e / rate`.
+        let first_mean_depth = self.smith.rate(&self.ndf, side.frame(fresh.d)).recip();
+        let mut lanes = [fresh; LANES];
+        let mut active = [false; LANES];
+        let mut unstarted = photons;
+        for a in active.iter_mut().take(photons.min(LANES as u64) as usize) {
+            *a = true;
+            unstarted -= 1;
+        }
+        let mut escapes = Escapes::new();
+        let mut no_stack = Vec::new();
+        while active.contains(&true) {
+            // Flights. While every lane can be refilled this round, escapes refill without a
+            // branch.
+            let refill = unstarted >= LANES as u64;
+            let mut arrived = [false; LANES];
+            for ((ray, active), arrived) in lanes.iter_mut().zip(&mut active).zip(&mut arrived) {
+                if !*active {
+                    continue;
+                }
+                let flight = self.fly(ray, exp1(rng));
+                escapes.record(flight.escapes, ray);
+                if refill {
+                    let first_tau = exp1(rng) * first_mean_depth;
+                    unstarted -= u64::from(flight.escapes);
+                    let (first, next) = (Ray { tau: first_tau, ..fresh }, Ray { tau: flight.tau, ..*ray });
+                    *ray = select_unpredictable(flight.escapes, first, next);
+                } else if flight.escapes {
+                    next_photon(&mut unstarted, ray, active, fresh);
+                    continue;
+                } else {
+                    ray.tau = flight.tau;
+                }
+                *arrived = self.arrive(ray, observer);
+                if !*arrived {
+                    observer.end_photon(u64::from(ray.order));
+                    next_photon(&mut unstarted, ray, active, fresh);
+                }
+            }
+            // The facets' normals, all lanes together (lanes that did not arrive draw too).
+            let directions = lanes.map(|ray| ray.side.frame(ray.d));
+            let normals = self.normals.sample_lanes(&self.ndf, directions, rng);
+            for (((ray, active), arrived), m) in lanes.iter_mut().zip(&mut active).zip(arrived).zip(normals) {
+                if arrived && !self.leave(facet, policy, ray, ray.side.frame(m), rng, &mut no_stack, observer) {
+                    observer.end_photon(u64::from(ray.order));
+                    next_photon(&mut unstarted, ray, active, fresh);
+                }
+            }
+            if escapes.len > ESCAPES - LANES {
+                escapes.flush(observer);
+            }
+        }
+        escapes.flush(observer);
+    }
+
     /// Follows one ray until it escapes, is absorbed or lost; split branches go onto `stack`.
     /// Returns the number of facet interactions it made.
     fn follow<F, R, O, const C: usize>(
@@ -131,63 +227,155 @@ impl<N: Ndf> Microsurface<N> {
     {
         let start = ray.order;
         loop {
-            // The flipped frame (§4.3): on the inside, negate the direction.
-            let d = match ray.side {
-                Side::Outside => ray.d,
-                Side::Inside => -ray.d,
-            };
-            let rate = self.smith.rate(&self.ndf, d);
-            ray.tau = match fly(ray.tau, d.z > 0.0, rate, exp1(rng)) {
-                Flight::Escape => {
-                    observer.escape(ray.order, ray.side, ray.d, &ray.beta);
-                    break;
-                }
-                Flight::Hit(tau) => tau,
-            };
-            if ray.tau.is_nan() {
-                observer.lose(Loss::Invalid, &ray.beta);
+            let flight = self.fly(&ray, exp1(rng));
+            if flight.escapes {
+                observer.escape(ray.order, ray.side, ray.d, &ray.beta);
                 break;
             }
-            if ray.tau.is_infinite() {
-                observer.lose(Loss::Trapped, &ray.beta);
+            ray.tau = flight.tau;
+            if !self.arrive(&mut ray, observer) {
                 break;
             }
-            ray.order += 1;
-            if ray.order >= RUNAWAY_ORDER {
-                observer.lose(Loss::Runaway, &ray.beta);
+            let m = self.facet_normal(&ray, rng);
+            if !self.leave(facet, policy, &mut ray, m, rng, stack, observer) {
                 break;
-            }
-            observer.hit(ray.order, ray.tau, ray.side, ray.d, &ray.beta);
-            let m_flipped = self.normals.sample(&self.ndf, d, rng);
-            let m = match ray.side {
-                Side::Outside => m_flipped,
-                Side::Inside => -m_flipped,
-            };
-            let branch = match facet.interact(-ray.d, m, ray.side, rng) {
-                Interaction::One(b) => b,
-                Interaction::Two(a, b) => {
-                    if policy.split && max_channel(&ray.beta) >= policy.threshold {
-                        stack.push(continue_with(&ray, &b));
-                        a
-                    } else {
-                        match choose(&ray.beta, a, b, open01(rng)) {
-                            Some(chosen) => chosen,
-                            None => break,
-                        }
-                    }
-                }
-            };
-            ray = continue_with(&ray, &branch);
-            if !ray.d.is_finite() || !weight_is_valid(&ray.beta) {
-                observer.lose(Loss::Invalid, &ray.beta);
-                break;
-            }
-            match roulette(&ray.beta, policy.threshold, rng) {
-                Some(beta) => ray.beta = beta,
-                None => break,
             }
         }
         ray.order - start
+    }
+
+    /// The free flight of `ray` with the standard exponential variate `e` (§2.4), in the
+    /// flipped frame on the inside (§4.3).
+    #[inline]
+    fn fly<const C: usize>(&self, ray: &Ray<C>, e: f64) -> Flight {
+        let d = ray.side.frame(ray.d);
+        fly(ray.tau, d.z > 0.0, self.smith.rate(&self.ndf, d), e)
+    }
+
+    /// The arrival of `ray` at the facet it hit at depth `ray.tau`: counts the interaction
+    /// and reports it to `observer`. Returns whether the ray can interact; when it cannot, its
+    /// loss (trapped, invalid, runaway) was reported to `observer`.
+    #[inline]
+    fn arrive<O: Observer<C>, const C: usize>(&self, ray: &mut Ray<C>, observer: &mut O) -> bool {
+        if ray.tau.is_nan() {
+            observer.lose(Loss::Invalid, &ray.beta);
+            return false;
+        }
+        if ray.tau.is_infinite() {
+            observer.lose(Loss::Trapped, &ray.beta);
+            return false;
+        }
+        ray.order += 1;
+        if ray.order >= RUNAWAY_ORDER {
+            observer.lose(Loss::Runaway, &ray.beta);
+            return false;
+        }
+        observer.hit(ray.order, ray.tau, ray.side, ray.d, &ray.beta);
+        true
+    }
+
+    /// The normal of the facet `ray` hit, in the frame of its side (§3.1, §4.3).
+    #[inline]
+    fn facet_normal<R: Rng + ?Sized, const C: usize>(&self, ray: &Ray<C>, rng: &mut R) -> DVec3 {
+        ray.side.frame(self.normals.sample(&self.ndf, ray.side.frame(ray.d), rng))
+    }
+
+    /// The interaction of `ray` with the facet of normal `m` it arrived at (§4.2–§4.6): lets
+    /// the facet act, splits or chooses between two branches and plays Russian roulette.
+    /// Returns whether the ray goes on (updated in place); when it does not, it was absorbed
+    /// or its loss was reported to `observer`.
+    #[inline]
+    #[allow(clippy::too_many_arguments)] // the walk's context (as for `follow`) plus the normal
+    fn leave<F, R, O, const C: usize>(
+        &self,
+        facet: &F,
+        policy: &EnergyPolicy,
+        ray: &mut Ray<C>,
+        m: DVec3,
+        rng: &mut R,
+        stack: &mut Vec<Ray<C>>,
+        observer: &mut O,
+    ) -> bool
+    where
+        F: Facet<C>,
+        R: Rng + ?Sized,
+        O: Observer<C>,
+    {
+        let branch = match facet.interact(-ray.d, m, ray.side, rng) {
+            Interaction::One(b) => b,
+            Interaction::Two(a, b) => {
+                if policy.split && max_channel(&ray.beta) >= policy.threshold {
+                    stack.push(continue_with(ray, &b));
+                    a
+                } else {
+                    match choose(&ray.beta, a, b, open01(rng)) {
+                        Some(chosen) => chosen,
+                        None => return false,
+                    }
+                }
+            }
+        };
+        *ray = continue_with(ray, &branch);
+        if !ray.d.is_finite() || !weight_is_valid(&ray.beta) {
+            observer.lose(Loss::Invalid, &ray.beta);
+            return false;
+        }
+        match roulette(&ray.beta, policy.threshold, rng) {
+            Some(beta) => {
+                ray.beta = beta;
+                true
+            }
+            None => false,
+        }
+    }
+}
+
+/// A lane whose photon ended takes the next unstarted one, `fresh`, or retires when none is left.
+#[inline]
+fn next_photon<const C: usize>(unstarted: &mut u64, ray: &mut Ray<C>, active: &mut bool, fresh: Ray<C>) {
+    if *unstarted > 0 {
+        *unstarted -= 1;
+        *ray = fresh;
+    } else {
+        *active = false;
+    }
+}
+
+/// Photons walked side by side by [`Microsurface::walk_side_by_side`].
+pub const LANES: usize = 4;
+
+/// Capacity of the buffer of escapes waiting to be reported.
+const ESCAPES: usize = 64;
+
+/// Escapes waiting to be reported: each is a whole photon (paths walked side by side do not
+/// split).
+struct Escapes<const C: usize> {
+    rays: [Ray<C>; ESCAPES],
+    len: usize,
+}
+
+impl<const C: usize> Escapes<C> {
+    fn new() -> Self {
+        Self {
+            rays: [Ray { tau: 0.0, d: DVec3::ZERO, side: Side::Outside, beta: [0.0; C], order: 0 }; ESCAPES],
+            len: 0,
+        }
+    }
+
+    /// Keeps `ray` if it `escapes`: written either way, kept by advancing the length, so that
+    /// an unpredictable escape costs no branch.
+    #[inline]
+    fn record(&mut self, escapes: bool, ray: &Ray<C>) {
+        self.rays[self.len] = *ray;
+        self.len += usize::from(escapes);
+    }
+
+    /// Reports every kept escape as a whole photon.
+    fn flush<O: Observer<C>>(&mut self, observer: &mut O) {
+        for ray in &self.rays[..self.len] {
+            observer.escape_photon(ray.order, ray.side, ray.d, &ray.beta);
+        }
+        self.len = 0;
     }
 }
 
