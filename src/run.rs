@@ -228,18 +228,6 @@ struct Walker<'a, N, F> {
     settings: &'a RunSettings,
 }
 
-impl<N: Ndf, F> Walker<'_, N, F> {
-    /// Whether the measurement walks photons side by side
-    /// ([`Microsurface::walk_side_by_side`]): when its paths never split. Part of the output's
-    /// identity, like [`CHUNK`]: the two ways draw random numbers in different orders.
-    fn side_by_side<const C: usize>(&self) -> bool
-    where
-        F: Facet<C>,
-    {
-        !(self.settings.policy.split && self.facet.may_split())
-    }
-}
-
 impl<N, F, const C: usize> CaseWalker for (Walker<'_, N, F>, [(); C])
 where
     N: Ndf,
@@ -256,15 +244,17 @@ where
         let detector = Detector::<C>::of_result(into);
         let wi = w.case.incident_direction();
         let mut rng = chunk_rng(w.settings.seed, w.case.index, chunk);
-        let mut stack = Vec::new();
         let policy = &w.settings.policy;
-        let mut nee_rng = chunk_rng(w.settings.seed ^ NEE_STREAMS, w.case.index, chunk);
-        let mut profile = DepthProfile::default();
         let photons = w.settings.chunk_photons(chunk);
-        if w.settings.estimator == Estimator::Walk && w.side_by_side() {
+        // Paths that never split are measured side by side. Which walk runs is part of the
+        // output's identity, like CHUNK: the two draw random numbers in different orders.
+        if w.settings.estimator == Estimator::Walk && policy.never_splits(&w.facet) {
             w.surface.walk_side_by_side(&w.facet, policy, wi, photons, &mut rng, detector);
             return;
         }
+        let mut stack = Vec::new();
+        let mut nee_rng = chunk_rng(w.settings.seed ^ NEE_STREAMS, w.case.index, chunk);
+        let mut profile = DepthProfile::default();
         for _ in 0..photons {
             let interactions = match w.settings.estimator {
                 Estimator::Walk => w.surface.trace(&w.facet, policy, wi, &mut rng, &mut stack, detector),

@@ -39,6 +39,14 @@ pub struct EnergyPolicy {
     pub threshold: f64,
 }
 
+impl EnergyPolicy {
+    /// Whether paths never split under this policy with `facet` (the condition of
+    /// [`Microsurface::walk_side_by_side`]).
+    pub fn never_splits<F: Facet<C>, const C: usize>(&self, facet: &F) -> bool {
+        !(self.split && facet.may_split())
+    }
+}
+
 /// Why a path ended without escaping and without being absorbed (§10, NaN policy).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Loss {
@@ -151,7 +159,7 @@ impl<N: Ndf> Microsurface<N> {
         R: Rng + ?Sized,
         O: Observer<C>,
     {
-        assert!(!(policy.split && facet.may_split()), "walk_side_by_side cannot split paths");
+        assert!(policy.never_splits(facet), "walk_side_by_side cannot split paths");
         let side = if wi.z >= 0.0 { Side::Outside } else { Side::Inside };
         let fresh = Ray { tau: 0.0, d: -wi, side, beta: [1.0; C], order: 0 };
         // The first flight, downward from depth 0, always hits: at depth `e / rate`.
