@@ -96,6 +96,15 @@ pub struct Ray<const C: usize> {
     order: u32,
 }
 
+impl<const C: usize> Ray<C> {
+    /// A photon arriving from `wi` (towards the light): on the light's side at depth 0, with
+    /// unit weight and no interaction yet.
+    fn entering(wi: DVec3) -> Self {
+        let side = if wi.z >= 0.0 { Side::Outside } else { Side::Inside };
+        Ray { tau: 0.0, d: -wi, side, beta: [1.0; C], order: 0 }
+    }
+}
+
 fn max_channel<const C: usize>(w: &[f64; C]) -> f64 {
     w.iter().copied().fold(0.0, f64::max)
 }
@@ -123,9 +132,8 @@ impl<N: Ndf> Microsurface<N> {
         R: Rng + ?Sized,
         O: Observer<C>,
     {
-        let side = if wi.z >= 0.0 { Side::Outside } else { Side::Inside };
         stack.clear();
-        stack.push(Ray { tau: 0.0, d: -wi, side, beta: [1.0; C], order: 0 });
+        stack.push(Ray::entering(wi));
         let mut interactions = 0;
         while let Some(ray) = stack.pop() {
             interactions += u64::from(self.follow(facet, policy, ray, rng, stack, observer));
@@ -160,10 +168,9 @@ impl<N: Ndf> Microsurface<N> {
         O: Observer<C>,
     {
         assert!(policy.never_splits(facet), "walk_side_by_side cannot split paths");
-        let side = if wi.z >= 0.0 { Side::Outside } else { Side::Inside };
-        let fresh = Ray { tau: 0.0, d: -wi, side, beta: [1.0; C], order: 0 };
+        let fresh = Ray::entering(wi);
         // The first flight, downward from depth 0, always hits: at depth `e / rate`.
-        let first_mean_depth = self.smith.rate(&self.ndf, side.frame(fresh.d)).recip();
+        let first_mean_depth = self.smith.rate(&self.ndf, fresh.side.frame(fresh.d)).recip();
         let mut lanes = [fresh; LANES];
         let mut active = [false; LANES];
         let mut unstarted = photons;
