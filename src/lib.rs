@@ -17,6 +17,8 @@ pub mod models;
 pub mod output;
 pub mod plot;
 pub mod quadrature;
+#[cfg(feature = "mpi")]
+pub mod ranks;
 pub mod rgl;
 pub mod run;
 pub mod rundir;

@@ -201,22 +201,16 @@ struct RunArgs {
     checkpoint_seconds: f64,
 }
 
-fn run(
-    RunArgs { config: config_path, paths, seed, threads, out, shard, resume, checkpoint_seconds }: RunArgs,
-) -> Result<()> {
-    let mut config = Config::load(&config_path)?;
-    if let Some(p) = paths {
-        config.paths = p;
+fn run(args: RunArgs) -> Result<()> {
+    let config = run_config(&args)?;
+    let out = args.out.clone().unwrap_or_else(|| default_out(&args.config));
+    #[cfg(feature = "mpi")]
+    if let Some(ranks) = smithwalk::ranks::Ranks::join()? {
+        let result = run_ranks(&args, &config, &out, &ranks);
+        ranks.abort_on_error(result);
+        return Ok(());
     }
-    if let Some(s) = seed {
-        config.seed = s;
-    }
-    config.validate()?;
-    check_threads(threads)?;
-    if !(checkpoint_seconds.is_finite() && checkpoint_seconds > 0.0) {
-        bail!("`--checkpoint-seconds` = {checkpoint_seconds} is not allowed: a positive number of seconds");
-    }
-    let shard = shard.unwrap_or(Shard::WHOLE);
+    let shard = args.shard.unwrap_or(Shard::WHOLE);
     if shard.count > 1 && config.precision.is_some() {
         bail!(
             "`--shard` = {}/{} is not allowed with a `[precision]` target: shards would stop independently",
@@ -224,14 +218,8 @@ fn run(
             shard.count
         );
     }
-    let out = out.unwrap_or_else(|| default_out(&config_path));
     prepare_dir(&out)?;
-    let states = if resume { checkpoint::load(&out, &config, shard)? } else { None };
-    let mut checkpoints = Checkpointer::new(&out, Duration::from_secs_f64(checkpoint_seconds), &config, shard)?;
-    let options = RunOptions { shard, threads, show_progress: true, estimator: Estimator::Walk };
-    let sim = smithwalk::simulate_from(&config, &options, states, &mut |done, current, later| {
-        checkpoints.after_round(done, current, later)
-    })?;
+    let (sim, checkpoints) = walk(&args, &config, shard, &out, true)?;
     if shard != Shard::WHOLE {
         let written = write_shard(&sim, &config, shard, &out)?;
         checkpoints.finish()?;
@@ -248,13 +236,87 @@ fn run(
     }
     let written = smithwalk::write_outputs(&sim, &config, &out)?;
     checkpoints.finish()?;
-    report(&sim, &config, &written)?;
+    finish_run(&sim, &config, &out, &written, args.threads)
+}
+
+/// The config of a run with the command line's overrides, validated with the command line.
+fn run_config(args: &RunArgs) -> Result<Config> {
+    let mut config = Config::load(&args.config)?;
+    if let Some(p) = args.paths {
+        config.paths = p;
+    }
+    if let Some(s) = args.seed {
+        config.seed = s;
+    }
+    config.validate()?;
+    check_threads(args.threads)?;
+    if !(args.checkpoint_seconds.is_finite() && args.checkpoint_seconds > 0.0) {
+        bail!("`--checkpoint-seconds` = {} is not allowed: a positive number of seconds", args.checkpoint_seconds);
+    }
+    Ok(config)
+}
+
+/// Walks `shard` of the run, checkpointing into `dir` (and resuming from there with
+/// `--resume`). Returns the simulation and the checkpointer, to remove the checkpoint once the
+/// run's results are safe.
+fn walk(
+    args: &RunArgs,
+    config: &Config,
+    shard: Shard,
+    dir: &Path,
+    show_progress: bool,
+) -> Result<(Simulation, Checkpointer)> {
+    let states = if args.resume { checkpoint::load(dir, config, shard)? } else { None };
+    let mut checkpoints = Checkpointer::new(dir, Duration::from_secs_f64(args.checkpoint_seconds), config, shard)?;
+    let options = RunOptions { shard, threads: args.threads, show_progress, estimator: Estimator::Walk };
+    let sim = smithwalk::simulate_from(config, &options, states, &mut |done, current, later| {
+        checkpoints.after_round(done, current, later)
+    })?;
+    Ok((sim, checkpoints))
+}
+
+/// After a run's outputs are written: the summary, and the comparison the config asks for.
+fn finish_run(
+    sim: &Simulation,
+    config: &Config,
+    out: &Path,
+    written: &[PathBuf],
+    threads: Option<usize>,
+) -> Result<()> {
+    report(sim, config, written)?;
     if let Some(c) = &config.compare {
         let models =
             c.models.iter().map(|m| Model::parse(m).map_err(anyhow::Error::msg)).collect::<Result<Vec<_>>>()?;
-        print!("{}", smithwalk::compare::compare(&out, &models, c.paths, threads)?);
+        print!("{}", smithwalk::compare::compare(out, &models, c.paths, threads)?);
     }
     Ok(())
+}
+
+/// A run under `mpirun` with several ranks: each walks its share, checkpointing into
+/// `OUT/rank-R-of-N`; rank 0 merges every rank's accumulators and writes the outputs. The
+/// checkpoints go only when the outputs are written.
+#[cfg(feature = "mpi")]
+fn run_ranks(args: &RunArgs, config: &Config, out: &Path, ranks: &smithwalk::ranks::Ranks) -> Result<()> {
+    use anyhow::Context as _;
+    if let Some(s) = args.shard {
+        bail!("`--shard` = {}/{} is not allowed under mpirun: the ranks share the work", s.index, s.count);
+    }
+    if config.precision.is_some() {
+        bail!("a `[precision]` target is not allowed under mpirun: the ranks would stop independently");
+    }
+    let shard = ranks.shard();
+    let dir = out.join(format!("rank-{}-of-{}", shard.index, shard.count));
+    prepare_dir(&dir)?;
+    let (sim, checkpoints) = walk(args, config, shard, &dir, ranks.is_root())?;
+    if let Some(shards) = ranks.gather(smithwalk::shard::encode(&sim, config, shard)?) {
+        let (config, sim) = smithwalk::shard::merge_bytes(&shards)?;
+        let written = smithwalk::write_outputs(&sim, &config, out)?;
+        finish_run(&sim, &config, out, &written, args.threads)?;
+    }
+    ranks.barrier();
+    checkpoints.finish()?;
+    // The directory is this rank's own; a kill during a checkpoint may have left a temporary file.
+    std::fs::remove_dir_all(&dir).with_context(|| format!("cannot remove {}", dir.display()))
 }
 
 /// `--threads`, when given, must be at least 1.

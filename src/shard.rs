@@ -91,8 +91,8 @@ struct ShardFile {
     tallies: Vec<CaseTallies>,
 }
 
-/// Writes the accumulators of a shard's simulation into `dir/shard.bin`, atomically.
-pub fn write_shard(sim: &Simulation, config: &Config, shard: Shard, dir: &Path) -> Result<PathBuf> {
+/// The bytes of a shard: the accumulators of a shard's simulation with the config and share.
+pub fn encode(sim: &Simulation, config: &Config, shard: Shard) -> Result<Vec<u8>> {
     let file = ShardFile {
         format: FORMAT.into(),
         version: env!("CARGO_PKG_VERSION").into(),
@@ -102,18 +102,27 @@ pub fn write_shard(sim: &Simulation, config: &Config, shard: Shard, dir: &Path) 
         wall_seconds: sim.wall_seconds,
         tallies: sim.results.iter().map(CaseTallies::of).collect(),
     };
-    let bytes = postcard::to_stdvec(&file).context("cannot encode the shard")?;
-    let written = write_atomically(dir, &[(SHARD_FILE, bytes)])?;
+    postcard::to_stdvec(&file).context("cannot encode the shard")
+}
+
+/// Writes the accumulators of a shard's simulation into `dir/shard.bin`, atomically.
+pub fn write_shard(sim: &Simulation, config: &Config, shard: Shard, dir: &Path) -> Result<PathBuf> {
+    let written = write_atomically(dir, &[(SHARD_FILE, encode(sim, config, shard)?)])?;
     Ok(written.into_iter().next().expect("one file"))
+}
+
+/// A shard from its bytes; `origin` names where they came from in errors.
+fn decode(bytes: &[u8], origin: &str) -> Result<ShardFile> {
+    let file: ShardFile =
+        postcard::from_bytes(bytes).with_context(|| format!("{origin} is not a smithwalk shard file"))?;
+    ensure!(file.format == FORMAT, "{origin}: format {:?}, expected {FORMAT:?}", file.format);
+    Ok(file)
 }
 
 fn read_shard(dir: &Path) -> Result<ShardFile> {
     let path = dir.join(SHARD_FILE);
     let bytes = std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
-    let file: ShardFile =
-        postcard::from_bytes(&bytes).with_context(|| format!("{} is not a smithwalk shard file", path.display()))?;
-    ensure!(file.format == FORMAT, "{}: format {:?}, expected {FORMAT:?}", path.display(), file.format);
-    Ok(file)
+    decode(&bytes, &path.display().to_string())
 }
 
 /// Merges the shards saved in `dirs` into the simulation of the whole run, checking that they
@@ -121,18 +130,33 @@ fn read_shard(dir: &Path) -> Result<ShardFile> {
 pub fn merge(dirs: &[PathBuf]) -> Result<(Config, Simulation)> {
     ensure!(!dirs.is_empty(), "merge needs at least one shard directory");
     let files = dirs.iter().map(|d| read_shard(d)).collect::<Result<Vec<_>>>()?;
+    merge_files(&files, &dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>())
+}
+
+/// Merges the shards given as bytes (with names for errors) into the simulation of the whole
+/// run, as [`merge`] does with shard directories.
+#[cfg(feature = "mpi")]
+pub fn merge_bytes(shards: &[(String, Vec<u8>)]) -> Result<(Config, Simulation)> {
+    ensure!(!shards.is_empty(), "merging needs at least one shard");
+    let files = shards.iter().map(|(origin, bytes)| decode(bytes, origin)).collect::<Result<Vec<_>>>()?;
+    merge_files(&files, &shards.iter().map(|(origin, _)| origin.clone()).collect::<Vec<_>>())
+}
+
+/// Merges shards (named `origins` in errors), checking that they come from one config and
+/// together cover every share exactly once.
+fn merge_files(files: &[ShardFile], origins: &[String]) -> Result<(Config, Simulation)> {
     let first = &files[0];
     let count = first.shard.count;
     let mut seen = vec![false; count as usize];
-    for (file, dir) in files.iter().zip(dirs) {
+    for (file, origin) in files.iter().zip(origins) {
         if file.config_toml != first.config_toml || file.version != first.version {
-            bail!("{}: shard of a different config or smithwalk version than {}", dir.display(), dirs[0].display());
+            bail!("{origin}: shard of a different config or smithwalk version than {}", origins[0]);
         }
         if file.shard.count != count {
-            bail!("{}: shard {}/{} does not match {} shards", dir.display(), file.shard.index, file.shard.count, count);
+            bail!("{origin}: shard {}/{} does not match {} shards", file.shard.index, file.shard.count, count);
         }
         let slot = &mut seen[file.shard.index as usize];
-        ensure!(!*slot, "{}: shard {}/{count} given twice", dir.display(), file.shard.index);
+        ensure!(!*slot, "{origin}: shard {}/{count} given twice", file.shard.index);
         *slot = true;
     }
     let missing: Vec<String> =
@@ -147,9 +171,9 @@ pub fn merge(dirs: &[PathBuf]) -> Result<(Config, Simulation)> {
         let wi = case.incident_direction();
         let result = match &first.tallies[i] {
             CaseTallies::Mono(_) => {
-                CaseResult::Mono(Box::new(merged(grid, wi, max_order, &files, i, CaseTallies::mono)?))
+                CaseResult::Mono(Box::new(merged(grid, wi, max_order, files, i, CaseTallies::mono)?))
             }
-            CaseTallies::Rgb(_) => CaseResult::Rgb(Box::new(merged(grid, wi, max_order, &files, i, CaseTallies::rgb)?)),
+            CaseTallies::Rgb(_) => CaseResult::Rgb(Box::new(merged(grid, wi, max_order, files, i, CaseTallies::rgb)?)),
         };
         results.push(result);
     }

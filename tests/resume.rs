@@ -2,9 +2,12 @@
 //! ends with tables bit-identical to an uninterrupted run; precision targets stop cases at
 //! the same point whatever the thread count.
 
-use std::path::Path;
-use std::process::{Command, Stdio};
+mod common;
+
+use std::process::Stdio;
 use std::time::Duration;
+
+use common::{smithwalk_quiet, tables};
 
 const CONFIG: &str = r#"
 paths = 3_000_000
@@ -24,16 +27,6 @@ phi_bins = 16
 max_order = 4
 "#;
 
-fn smithwalk(args: &[&str]) -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_smithwalk"));
-    c.args(args).stdout(Stdio::null()).stderr(Stdio::null());
-    c
-}
-
-fn tables(dir: &Path) -> (Vec<u8>, Vec<u8>) {
-    (std::fs::read(dir.join("lobes.csv")).unwrap(), std::fs::read(dir.join("summary.csv")).unwrap())
-}
-
 #[test]
 fn killed_and_resumed_runs_equal_an_uninterrupted_run() {
     let root = tempfile::tempdir().unwrap();
@@ -41,7 +34,7 @@ fn killed_and_resumed_runs_equal_an_uninterrupted_run() {
     std::fs::write(&config, CONFIG).unwrap();
     let config = config.to_str().unwrap();
     let reference = root.path().join("reference");
-    let status = smithwalk(&["run", config, "--out", reference.to_str().unwrap()]).status().unwrap();
+    let status = smithwalk_quiet(&["run", config, "--out", reference.to_str().unwrap()]).status().unwrap();
     assert!(status.success());
 
     let out = root.path().join("interrupted");
@@ -56,7 +49,7 @@ fn killed_and_resumed_runs_equal_an_uninterrupted_run() {
         if out.join("checkpoint.bin").exists() {
             resumed_from_checkpoint += 1;
         }
-        let mut child = smithwalk(&args).spawn().unwrap();
+        let mut child = smithwalk_quiet(&args).spawn().unwrap();
         std::thread::sleep(Duration::from_millis(delay));
         if child.try_wait().unwrap().is_none() {
             child.kill().unwrap(); // SIGKILL
@@ -64,7 +57,7 @@ fn killed_and_resumed_runs_equal_an_uninterrupted_run() {
         child.wait().unwrap();
     }
     assert!(resumed_from_checkpoint > 0, "no kill left a checkpoint to resume from");
-    assert!(smithwalk(&args).status().unwrap().success());
+    assert!(smithwalk_quiet(&args).status().unwrap().success());
     assert!(tables(&reference) == tables(&out), "resumed run differs from the uninterrupted run");
     assert!(!out.join("checkpoint.bin").exists(), "checkpoint left behind after the run finished");
 }
@@ -76,7 +69,8 @@ fn resume_refuses_a_checkpoint_of_another_config() {
     std::fs::write(&config, CONFIG).unwrap();
     let out = root.path().join("out");
     let (config, out_arg) = (config.to_str().unwrap(), out.to_str().unwrap());
-    let mut child = smithwalk(&["run", config, "--out", out_arg, "--checkpoint-seconds", "0.05"]).spawn().unwrap();
+    let mut child =
+        smithwalk_quiet(&["run", config, "--out", out_arg, "--checkpoint-seconds", "0.05"]).spawn().unwrap();
     let start = std::time::Instant::now();
     while !out.join("checkpoint.bin").exists() {
         assert!(start.elapsed() < Duration::from_secs(60), "no checkpoint written");
@@ -84,7 +78,7 @@ fn resume_refuses_a_checkpoint_of_another_config() {
     }
     child.kill().unwrap();
     child.wait().unwrap();
-    let result = smithwalk(&["run", config, "--out", out_arg, "--resume", "--seed", "6"])
+    let result = smithwalk_quiet(&["run", config, "--out", out_arg, "--resume", "--seed", "6"])
         .stderr(Stdio::piped())
         .output()
         .unwrap();

@@ -1,7 +1,11 @@
 //! Runs split into shards and merged give exactly the unsplit run's tables (the accumulators
 //! are integers), and merge refuses incomplete, duplicated or mismatched shard sets.
 
+mod common;
+
 use std::path::{Path, PathBuf};
+
+use common::tables;
 
 use smithwalk::config::Config;
 use smithwalk::run::Shard;
@@ -26,10 +30,6 @@ cos_theta_bins = 8
 phi_bins = 16
 max_order = 3
 "#;
-
-fn tables(dir: &Path) -> (Vec<u8>, Vec<u8>) {
-    (std::fs::read(dir.join("lobes.csv")).unwrap(), std::fs::read(dir.join("summary.csv")).unwrap())
-}
 
 fn shard_dirs(config: &Config, count: u64, root: &Path) -> Vec<PathBuf> {
     (0..count)

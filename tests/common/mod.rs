@@ -8,6 +8,18 @@ use smithwalk::microsurface::DVec3;
 use smithwalk::run::CaseResult;
 use smithwalk::stats::WeightedBin;
 
+/// The `smithwalk` binary with `args`, its output discarded.
+pub fn smithwalk_quiet(args: &[&str]) -> std::process::Command {
+    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_smithwalk"));
+    c.args(args).stdout(std::process::Stdio::null()).stderr(std::process::Stdio::null());
+    c
+}
+
+/// The bytes of a run directory's `lobes.csv` and `summary.csv`.
+pub fn tables(dir: &std::path::Path) -> (Vec<u8>, Vec<u8>) {
+    (std::fs::read(dir.join("lobes.csv")).unwrap(), std::fs::read(dir.join("summary.csv")).unwrap())
+}
+
 /// Parses a TOML config and runs it on `threads` threads without a progress bar.
 pub fn simulate(toml: &str, threads: usize) -> Simulation {
     let config = Config::parse(toml).expect("test config is valid");
