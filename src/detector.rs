@@ -274,6 +274,10 @@ struct Binner {
     rotation: (f64, f64),
     /// Per cell: edges at or below its start, and the edge inside it (`inf` if none).
     cells: Vec<(usize, f64)>,
+    /// `cos_bins` and `cells.len() / 4` as floats, the scales from |cos| and diamond angle to
+    /// an index.
+    cos_scale: f64,
+    cell_scale: f64,
 }
 
 impl Binner {
@@ -294,17 +298,17 @@ impl Binner {
                 (below, inside)
             })
             .collect();
-        Self { grid, rotation, cells }
+        Self { grid, rotation, cells, cos_scale: grid.cos_bins as f64, cell_scale: 0.25 * count as f64 }
     }
 
     /// Bin index `cos_index * phi_bins + phi_index` of an escaping direction.
     #[inline]
     fn bin(&self, dir: DVec3) -> usize {
         let g = self.grid;
-        let ic = ((dir.z.abs() * g.cos_bins as f64) as usize).min(g.cos_bins - 1);
+        let ic = ((dir.z.abs() * self.cos_scale) as usize).min(g.cos_bins - 1);
         let (c, s) = self.rotation;
         let p = diamond_angle(c * dir.x + s * dir.y, c * dir.y - s * dir.x);
-        let cell = ((p * 0.25 * self.cells.len() as f64) as usize).min(self.cells.len() - 1);
+        let cell = ((p * self.cell_scale) as usize).min(self.cells.len() - 1);
         let (below, edge) = self.cells[cell];
         let ip = (below + usize::from(p >= edge)).min(g.phi_bins - 1);
         ic * g.phi_bins + ip
@@ -322,6 +326,9 @@ pub struct Detector<const C: usize> {
     pending: Vec<Deposit<C>>,
     pending_loss: [[f64; C]; 3],
     any_loss: bool,
+    /// The last whole photon's weight and its conversion: successive photons often carry the
+    /// same weight (always 1 on white surfaces), and the conversion is then not repeated.
+    last_whole: ([f64; C], Contribution<C>),
 }
 
 /// `acc += w`, channel by channel.
@@ -354,6 +361,7 @@ impl<const C: usize> Detector<C> {
             pending: Vec::new(),
             pending_loss: [[0.0; C]; 3],
             any_loss: false,
+            last_whole: ([0.0; C], Contribution::of(&[0.0; C])),
         }
     }
 
@@ -417,7 +425,10 @@ impl<const C: usize> Detector<C> {
     /// fixed point serves the accounted total and the photon's bin and albedo tallies.
     #[inline]
     fn add_whole_photon(&mut self, d: &Deposit<C>) {
-        let c = Contribution::of(&d.weight);
+        if d.weight != self.last_whole.0 {
+            self.last_whole = (d.weight, Contribution::of(&d.weight));
+        }
+        let c = self.last_whole.1;
         self.tallies.accounted.add_contribution(&c);
         self.add_to_orders(d, &c);
     }

@@ -109,8 +109,9 @@ fn max_channel<const C: usize>(w: &[f64; C]) -> f64 {
     w.iter().copied().fold(0.0, f64::max)
 }
 
+/// Finite and not negative, channel by channel (NaN fails both comparisons).
 fn weight_is_valid<const C: usize>(w: &[f64; C]) -> bool {
-    w.iter().all(|x| x.is_finite() && *x >= 0.0)
+    w.iter().all(|&x| (0.0..=f64::MAX).contains(&x))
 }
 
 impl<N: Ndf> Microsurface<N> {
