@@ -190,6 +190,7 @@ fn print_line(out: &mut impl std::io::Write, line: &str) -> Result<bool> {
 }
 
 /// The options of `smithwalk run`.
+#[derive(Clone)]
 struct RunArgs {
     config: PathBuf,
     paths: Option<u64>,
@@ -307,6 +308,8 @@ fn run_ranks(args: &RunArgs, config: &Config, out: &Path, ranks: &smithwalk::ran
     let shard = ranks.shard();
     let dir = out.join(format!("rank-{}-of-{}", shard.index, shard.count));
     prepare_dir(&dir)?;
+    let threads = args.threads.unwrap_or_else(|| ranks.default_threads());
+    let args = &RunArgs { threads: Some(threads), ..args.clone() };
     let (sim, checkpoints) = walk(args, config, shard, &dir, ranks.is_root())?;
     if let Some(shards) = ranks.gather(smithwalk::shard::encode(&sim, config, shard)?) {
         let (config, sim) = smithwalk::shard::merge_bytes(&shards)?;

@@ -44,6 +44,14 @@ impl Ranks {
         self.world.rank() == ROOT
     }
 
+    /// Worker threads for this rank when none are asked for: the machine's cores shared among
+    /// the ranks on this machine (those that share its memory), at least one.
+    pub fn default_threads(&self) -> usize {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let here = self.world.split_shared(self.world.rank()).size() as usize;
+        (cores / here.max(1)).max(1)
+    }
+
     /// Sends this rank's `bytes` to the root. On the root, returns every rank's bytes in rank
     /// order (its own first), each named `rank R`; elsewhere `None`.
     pub fn gather(&self, bytes: Vec<u8>) -> Option<Vec<(String, Vec<u8>)>> {

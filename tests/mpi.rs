@@ -70,11 +70,16 @@ fn ranks_reproduce_the_plain_run_bit_for_bit() {
     let config = &config_file(root.path(), "ranks.toml", CONFIG);
     let plain = root.path().join("plain");
     reference(config, &plain);
+    let cores = std::thread::available_parallelism().unwrap().get();
     for ranks in [2, 3] {
         let out = root.path().join(format!("np{ranks}"));
         let output =
-            mpirun(ranks, &["run", config, "--threads", "1", "--out", out.to_str().unwrap()]).output().unwrap();
+            mpirun(ranks, &["run", config, "--out", out.to_str().unwrap()]).stdout(Stdio::piped()).output().unwrap();
         assert!(output.status.success(), "np {ranks}: {}", String::from_utf8_lossy(&output.stderr));
+        // Without `--threads`, the ranks on one machine share its cores.
+        let threads = format!(" on {} threads:", (cores / ranks).max(1) * ranks);
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(stdout.contains(&threads), "np {ranks} on {cores} cores: expected {threads:?} in {stdout}");
         assert!(tables(&plain) == tables(&out), "np {ranks}: tables differ from the plain run");
         assert_eq!(entries(&out), ["lobes.csv", "run.json", "summary.csv"], "np {ranks}: left-overs");
     }
