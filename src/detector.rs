@@ -305,10 +305,12 @@ impl Binner {
     #[inline]
     fn bin(&self, dir: DVec3) -> usize {
         let g = self.grid;
-        let ic = ((dir.z.abs() * self.cos_scale) as usize).min(g.cos_bins - 1);
+        // Both products are at least 0, where truncation through i64 (one instruction, unlike
+        // u64) gives the same index.
+        let ic = ((dir.z.abs() * self.cos_scale) as i64 as usize).min(g.cos_bins - 1);
         let (c, s) = self.rotation;
         let p = diamond_angle(c * dir.x + s * dir.y, c * dir.y - s * dir.x);
-        let cell = ((p * self.cell_scale) as usize).min(self.cells.len() - 1);
+        let cell = ((p * self.cell_scale) as i64 as usize).min(self.cells.len() - 1);
         let (below, edge) = self.cells[cell];
         let ip = (below + usize::from(p >= edge)).min(g.phi_bins - 1);
         ic * g.phi_bins + ip
