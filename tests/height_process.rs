@@ -3,9 +3,10 @@
 //! From a height with `u = C1(h)`, a ray travelling along `d` escapes (upward only) with
 //! probability `G1(d, h) = u^Lambda(d)` (§2.2); otherwise it stops at `u'` with
 //! `P(u' <= x | hit) = (1 - (u/x)^Lambda) / (1 - u^Lambda)` upward and `(x/u)^lambda` downward
-//! (§2.3). Each check uses 200 000 flights: escapes by a two-sided binomial z test, next
-//! heights by a chi-square over 20 equiprobable bins (expected count 10 000 each, no pooling);
-//! all at the Sidak level that keeps the family at 0.01. The walk runs in optical depth
+//! (§2.3), and what is left of an escaping flight's exponential variate is again a standard
+//! exponential (§2.4). Each check uses 200 000 flights: escapes by a two-sided binomial z test,
+//! next heights and escape excesses by a chi-square over 20 equiprobable bins (thousands of
+//! samples per bin, no pooling); all at the Sidak level that keeps the family at 0.01. The walk runs in optical depth
 //! `tau = -ln u` (§2.4); `u` is the height's CDF value, so for uniform heights on [-1, 1] the
 //! height is `2u - 1` and for Gaussian heights `Phi^{-1}(u)`: the law of `u` is the law of the
 //! height for every height distribution (§2.1).
@@ -56,9 +57,13 @@ fn run<N: Ndf>(ndf: &N, seed: u128, level: f64) {
         let mut rng = Pcg64Mcg::new(seed + i as u128);
         let mut escapes = 0u64;
         let mut next = Vec::new();
+        let mut excess = Vec::new();
         for _ in 0..FLIGHTS {
             match fly(tau, up, rate, exp1(&mut rng)) {
-                Flight { escapes: true, .. } => escapes += 1,
+                Flight { escapes: true, excess: e, .. } => {
+                    escapes += 1;
+                    excess.push(e);
+                }
                 Flight { tau: t, .. } => next.push((-t).exp()),
             }
         }
@@ -82,23 +87,35 @@ fn run<N: Ndf>(ndf: &N, seed: u128, level: f64) {
                 c.u * q.powf(1.0 / rate)
             }
         };
-        let edges: Vec<f64> = (0..=BINS).map(|k| quantile(k as f64 / BINS as f64)).collect();
-        let mut counts = [0u64; BINS];
-        for x in &next {
-            let k = edges.partition_point(|e| e <= x).clamp(1, BINS) - 1;
-            counts[k] += 1;
-        }
-        let hits = next.len() as f64;
-        let observed: Vec<WeightedBin> =
-            counts.iter().map(|&k| WeightedBin { mean: k as f64 / hits, second_moment: k as f64 / hits }).collect();
-        let test = chi_square(&observed, &[1.0 / BINS as f64; BINS], next.len() as u64, 5.0);
+        let test = equiprobable(&next, quantile);
         assert!(test.p_value > level, "{label}: next-height distribution rejected\n{}", test.worst_cells(BINS));
+        // What is left of an escaping flight's variate is a standard exponential (§2.4, no
+        // memory): equiprobable bins with edges -ln(1 - q).
+        if up {
+            let test = equiprobable(&excess, |q| -(1.0 - q).ln());
+            assert!(test.p_value > level, "{label}: excess of escapes rejected\n{}", test.worst_cells(BINS));
+        }
     }
+}
+
+/// Chi-square of `samples` over `BINS` bins that are equiprobable under the law of quantile
+/// function `quantile`.
+fn equiprobable(samples: &[f64], quantile: impl Fn(f64) -> f64) -> smithwalk::stats::ChiSquare {
+    let edges: Vec<f64> = (0..=BINS).map(|k| quantile(k as f64 / BINS as f64)).collect();
+    let mut counts = [0u64; BINS];
+    for x in samples {
+        let k = edges.partition_point(|e| e <= x).clamp(1, BINS) - 1;
+        counts[k] += 1;
+    }
+    let n = samples.len() as f64;
+    let observed: Vec<WeightedBin> =
+        counts.iter().map(|&k| WeightedBin { mean: k as f64 / n, second_moment: k as f64 / n }).collect();
+    chi_square(&observed, &[1.0 / BINS as f64; BINS], samples.len() as u64, 5.0)
 }
 
 #[test]
 fn escape_probability_and_next_height_follow_the_smith_height_process() {
-    let level = sidak(0.01, 2 * 2 * CHECKS.len());
+    let level = sidak(0.01, 2 * 3 * CHECKS.len());
     let r = Roughness { x: 0.6, y: 0.3 };
     run(&Ggx(r), 1 << 40, level);
     run(&Beckmann(r), 3 << 40, level);
@@ -110,14 +127,17 @@ fn limits_of_the_free_flight() {
     // depth (rate = inf), straight down has rate 1 (u' = U u).
     let ndf = Ggx(Roughness::isotropic(0.5));
     assert_eq!(Smith::Exact.rate(&ndf, DVec3::Z), 0.0);
-    assert!(fly(3.0, true, 0.0, 0.7).escapes);
+    let f = fly(3.0, true, 0.0, 0.7);
+    assert!(f.escapes && f.excess == 0.7, "straight up, the whole variate is left: {f:?}");
     let horizontal = DVec3::new(1.0, 0.0, 0.0);
     assert_eq!(Smith::Exact.rate(&ndf, horizontal), f64::INFINITY);
-    assert_eq!(fly(0.4, false, f64::INFINITY, 2.0), Flight { escapes: false, tau: 0.4 });
+    let f = fly(0.4, false, f64::INFINITY, 2.0);
+    assert_eq!((f.escapes, f.tau), (false, 0.4));
     assert_eq!(Smith::Exact.rate(&ndf, -DVec3::Z), 1.0);
     // Hammon's symmetric Lambda gives a vertical downward ray rate 0 (§2.7): infinite depth.
     assert_eq!(Smith::Symmetric.rate(&ndf, -DVec3::Z), 0.0);
-    assert_eq!(fly(0.4, false, 0.0, 1.0), Flight { escapes: false, tau: f64::INFINITY });
+    let f = fly(0.4, false, 0.0, 1.0);
+    assert_eq!((f.escapes, f.tau), (false, f64::INFINITY));
     // The same point seen from the other side (§4.3): -ln(1 - e^{-tau}), accurate at both ends
     // (closed forms: tau -> 0 gives -ln tau; large tau gives e^{-tau}), and an involution.
     assert!((other_side_depth(1.0) - -(1.0 - (-1.0f64).exp()).ln()).abs() < 1e-15);

@@ -16,6 +16,11 @@ pub struct Flight {
     pub escapes: bool,
     /// The optical depth of the facet hit, if it does not.
     pub tau: f64,
+    /// If it escapes: the part of the exponential variate beyond what the escape took,
+    /// `e - rate tau`. The exponential law has no memory, so given the escape this is again a
+    /// standard exponential variate, independent of the flight and of all before it: one
+    /// draw can serve the next photon (§2.4).
+    pub excess: f64,
 }
 
 /// One free flight from optical depth `tau` (on the ray's own side) for a ray travelling up
@@ -27,7 +32,7 @@ pub fn fly(tau: f64, up: bool, rate: f64, e: f64) -> Flight {
     let travelled = e / rate;
     // Whether a ray goes up is a coin toss for the branch predictor: select, do not branch.
     let tau_hit = std::hint::select_unpredictable(up, tau - travelled, tau + travelled);
-    Flight { escapes: up && travelled > tau, tau: tau_hit }
+    Flight { escapes: up && travelled > tau, tau: tau_hit, excess: e - rate * tau }
 }
 
 /// The optical depth of the same point seen from the other side of the heightfield (§4.3):

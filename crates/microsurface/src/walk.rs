@@ -193,7 +193,10 @@ impl<N: Ndf> Microsurface<N> {
                 let flight = self.fly(ray, exp1(rng));
                 escapes.record(flight.escapes, ray);
                 if refill {
-                    let first_tau = exp1(rng) * first_mean_depth;
+                    // The next photon's first depth reuses what is left of this flight's
+                    // variate once it escaped (a fresh standard exponential, `Flight::excess`);
+                    // rounding may leave it a hair below 0.
+                    let first_tau = flight.excess.max(0.0) * first_mean_depth;
                     unstarted -= u64::from(flight.escapes);
                     let (first, next) = (Ray { tau: first_tau, ..fresh }, Ray { tau: flight.tau, ..*ray });
                     *ray = select_unpredictable(flight.escapes, first, next);
