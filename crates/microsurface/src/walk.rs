@@ -151,7 +151,8 @@ impl<N: Ndf> Microsurface<N> {
     /// flight escapes is a coin toss that ends the chain. Side by side, the chains of several
     /// photons overlap, and an escape does not branch: it is recorded into a buffer and its lane
     /// is refilled with the next photon (whose first flight, downward from depth 0, always
-    /// hits) by selection. The buffer is handed to `observer` when it fills.
+    /// hits, at a depth drawn from what is left of the escaping flight's variate,
+    /// [`Flight::excess`]) by selection. The buffer is handed to `observer` when it fills.
     ///
     /// Only for paths that never split: a facet with two branches must be walked with
     /// `policy.split` off (a random choice, §4.6). Panics otherwise.
