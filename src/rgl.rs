@@ -7,8 +7,8 @@
 //! (1 = u8, 10 = f32), a `u64` byte offset and `rank` `u64` extents; then each field's data,
 //! row-major, at its offset (8-byte aligned here).
 //!
-//! The fields: `description` (u8 text), `jacobian` ([1] u8), `theta_i` (the swept incident
-//! angles in radians, ascending), `phi_i` ([0]: one azimuth, isotropic), `ndf` and `sigma`
+//! The fields: `description` (u8 text), `jacobian` (`[1]` u8), `theta_i` (the swept incident
+//! angles in radians, ascending), `phi_i` (`[0]`: one azimuth, isotropic), `ndf` and `sigma`
 //! ([2, n]), `vndf` and `luminance` ([1, n_theta, n, n]) and `rgb` ([1, n_theta, 3, n, n]).
 //!
 //! The parameterization: a pair of directions is addressed by its half vector m at

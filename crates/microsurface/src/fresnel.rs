@@ -26,7 +26,7 @@ pub fn conductor(eta: f64, k: f64, c: f64) -> f64 {
 }
 
 /// Exact unpolarized reflectance of a dielectric interface with relative index
-/// `eta = eta_t / eta_i` ([W07] Eq. 22, §4.3); 1 under total internal reflection.
+/// `eta = eta_t / eta_i` (\[W07\] Eq. 22, §4.3); 1 under total internal reflection.
 pub fn dielectric(eta: f64, c: f64) -> f64 {
     let c = c.clamp(0.0, 1.0);
     let g2 = eta * eta - 1.0 + c * c;

@@ -137,7 +137,7 @@ impl Ndf for Ggx {
         std::array::from_fn(|i| self.cap_sample(w[i], azimuths[i], heights[i]))
     }
 
-    /// `cos^2 theta = 1 - u` for roughness 1 ([Ham17], "Intersection normal"), so `tan^2 = u / (1 - u)`.
+    /// `cos^2 theta = 1 - u` for roughness 1 (\[Ham17\], "Intersection normal"), so `tan^2 = u / (1 - u)`.
     fn std_slope_radius(u: f64) -> f64 {
         (u / (1.0 - u)).sqrt()
     }

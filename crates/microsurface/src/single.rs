@@ -30,7 +30,7 @@ pub fn reflection<N: Ndf>(ndf: &N, wi: DVec3, wo: DVec3, fresnel: impl Fn(f64) -
     fresnel(wi.dot(h)) * ndf.d(h) * g2_reflection(ndf, wi, wo) / (4.0 * wi.z)
 }
 
-/// Dielectric transmission in its power-conserving form (§5, [W07] Eq. 21 with `G2^T`):
+/// Dielectric transmission in its power-conserving form (§5, \[W07\] Eq. 21 with `G2^T`):
 /// `wi` above, `wo` below, `eta = eta_o / eta_i`; `fresnel` is the reflectance at `wi·h`.
 pub fn transmission<N: Ndf>(ndf: &N, wi: DVec3, wo: DVec3, eta: f64, fresnel: impl Fn(f64) -> f64) -> f64 {
     if wi.z <= 0.0 || wo.z >= 0.0 {
