@@ -6,10 +6,10 @@
 //! (§2.3), and what is left of an escaping flight's exponential variate is again a standard
 //! exponential (§2.4). Each check uses 200 000 flights: escapes by a two-sided binomial z test,
 //! next heights and escape excesses by a chi-square over 20 equiprobable bins (thousands of
-//! samples per bin, no pooling); all at the Sidak level that keeps the family at 0.01. The walk runs in optical depth
-//! `tau = -ln u` (§2.4); `u` is the height's CDF value, so for uniform heights on [-1, 1] the
-//! height is `2u - 1` and for Gaussian heights `Phi^{-1}(u)`: the law of `u` is the law of the
-//! height for every height distribution (§2.1).
+//! samples per bin, no pooling); all at the Sidak level that keeps the family at 0.01. The
+//! walk runs in optical depth `tau = -ln u` (§2.4); `u` is the height's CDF value, so for
+//! uniform heights on [-1, 1] the height is `2u - 1` and for Gaussian heights `Phi^{-1}(u)`:
+//! the law of `u` is the law of the height for every height distribution (§2.1).
 
 mod common;
 
