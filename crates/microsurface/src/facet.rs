@@ -11,7 +11,7 @@ use rand::Rng;
 
 use crate::fresnel;
 use crate::ndf::Ndf;
-use crate::random::{open01, unit_circle};
+use crate::random::{azimuth, open01};
 use crate::roots::newton_bisect;
 
 /// Which side of the heightfield a ray is on (§4.3): outside (above) or inside (below, only
@@ -243,7 +243,7 @@ impl<const C: usize> Facet<C> for Lambertian<C> {
     fn interact<R: Rng + ?Sized>(&self, _w: DVec3, m: DVec3, _side: Side, rng: &mut R) -> Interaction<C> {
         let u = open01(rng);
         let cos_theta = (1.0 - u).sqrt();
-        let dir = about_normal(m, cos_theta, unit_circle(rng));
+        let dir = about_normal(m, cos_theta, azimuth(rng));
         Interaction::One(Branch { dir, weight: self.albedo, crosses: false })
     }
 
@@ -281,7 +281,7 @@ impl<const C: usize> Facet<C> for Hammon<C> {
         let f = self.f0.map(|f0| fresnel::schlick(f0, w.dot(m)));
         let specular = Branch { dir: reflect(w, m), weight: f, crosses: false };
         let cos_theta = hammon_exit_cosine(open01(rng));
-        let dir = about_normal(m, cos_theta, unit_circle(rng));
+        let dir = about_normal(m, cos_theta, azimuth(rng));
         let weight = std::array::from_fn(|i| (1.0 - f[i]) * self.albedo[i]);
         Interaction::Two(specular, Branch { dir, weight, crosses: false })
     }

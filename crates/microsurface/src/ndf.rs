@@ -11,7 +11,7 @@ use glam::DVec3;
 use rand::Rng;
 use statrs::function::erf::{erf_inv, erfc};
 
-use crate::random::{open01, unit_circle};
+use crate::random::{azimuth, open01};
 use crate::roots::newton_bisect;
 
 const SQRT_PI: f64 = 1.772_453_850_905_516;
@@ -126,13 +126,13 @@ impl Ndf for Ggx {
 
     /// Dupuy & Benyoub 2023 spherical caps (§3.2), exact on the full sphere.
     fn sample_visible<R: Rng + ?Sized>(&self, w: DVec3, rng: &mut R) -> DVec3 {
-        let azimuth = unit_circle(rng);
+        let azimuth = azimuth(rng);
         self.cap_sample(w, azimuth, open01(rng))
     }
 
     #[inline]
     fn sample_visible_lanes<R: Rng + ?Sized, const L: usize>(&self, w: [DVec3; L], rng: &mut R) -> [DVec3; L] {
-        let azimuths: [(f64, f64); L] = std::array::from_fn(|_| unit_circle(rng));
+        let azimuths: [(f64, f64); L] = std::array::from_fn(|_| azimuth(rng));
         let heights: [f64; L] = std::array::from_fn(|_| open01(rng));
         std::array::from_fn(|i| self.cap_sample(w[i], azimuths[i], heights[i]))
     }
