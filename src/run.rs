@@ -2,7 +2,10 @@
 //! stream derived from (seed, case, chunk), and spread over a thread pool. Detectors are merged
 //! with exact integer sums, so outputs are bit-identical for any thread count.
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::collections::BTreeMap;
+use std::collections::btree_map::Entry;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc;
 
 use indicatif::ProgressBar;
 use microsurface::chain;
@@ -354,24 +357,45 @@ pub struct CaseState {
 }
 
 impl RunSettings {
-    /// The chunks of this shard in round `round`.
-    fn round_chunks(&self, round: u64) -> Vec<u64> {
-        let first = round * ROUND_CHUNKS;
-        (first..first + ROUND_CHUNKS)
-            .map(|k| self.shard.index + k * self.shard.count)
-            .filter(|&c| c < self.chunks())
-            .collect()
+    /// Chunks of this shard.
+    fn shard_chunks(&self) -> u64 {
+        self.chunks().saturating_sub(self.shard.index).div_ceil(self.shard.count)
+    }
+
+    /// The `k`-th chunk of this shard, if it has that many.
+    fn shard_chunk(&self, k: u64) -> Option<u64> {
+        (k < self.shard_chunks()).then(|| self.shard.index + k * self.shard.count)
     }
 
     /// Rounds of this shard.
     fn rounds(&self) -> u64 {
-        let mine = self.chunks().saturating_sub(self.shard.index).div_ceil(self.shard.count);
-        mine.div_ceil(ROUND_CHUNKS)
+        self.shard_chunks().div_ceil(ROUND_CHUNKS)
+    }
+
+    /// Chunks of this shard in round `round`.
+    fn round_len(&self, round: u64) -> u64 {
+        self.shard_chunks().saturating_sub(round * ROUND_CHUNKS).min(ROUND_CHUNKS)
     }
 }
 
+/// What one thread walked of one round: `chunks` of its chunks, in `result`.
+struct RoundPart {
+    round: u64,
+    chunks: u64,
+    result: CaseResult,
+}
+
 /// Continues one case from `state` round by round until its chunks are done or `after_round`
-/// returns false (it is called after every round, e.g. to checkpoint or check precision).
+/// returns false (it is called after every round, in order, e.g. to checkpoint or check
+/// precision).
+///
+/// There is no barrier between rounds, so that every thread stays busy at round ends and
+/// however many threads there are per round. The pool's threads take this shard's chunks in
+/// sequence, each walking into its own part of the round of its chunk and handing the part
+/// over when it moves on to the next round. The calling thread adds the parts up and passes
+/// each round to `state` once all its chunks are in, rounds in order; when the case stops,
+/// chunks already walked in later rounds are dropped. So `state` always holds whole rounds
+/// and ends as the rounds walked one after the other would leave it.
 pub fn run_case(
     walker: &dyn CaseWalker,
     settings: &RunSettings,
@@ -380,26 +404,80 @@ pub fn run_case(
     progress: &ProgressBar,
     after_round: &mut dyn FnMut(&CaseState) -> anyhow::Result<bool>,
 ) -> anyhow::Result<()> {
-    while !state.finished {
-        let chunks = settings.round_chunks(state.rounds_done);
-        let next = AtomicU64::new(0);
-        let partials = pool.broadcast(|_| {
-            let mut detector = walker.empty();
-            loop {
-                let k = next.fetch_add(1, Ordering::Relaxed) as usize;
-                let Some(&chunk) = chunks.get(k) else { break detector };
-                walker.walk_chunk(chunk, &mut detector);
-                progress.inc(settings.chunk_photons(chunk));
-            }
-        });
-        for p in &partials {
-            state.result.merge(p);
-        }
-        state.rounds_done += 1;
-        state.finished = state.rounds_done >= settings.rounds();
-        if !after_round(state)? {
-            state.finished = true;
-        }
+    if state.rounds_done >= settings.rounds() {
+        // A shard without chunks (more shards than chunks) has no rounds.
+        state.finished = true;
     }
-    Ok(())
+    if state.finished {
+        return Ok(());
+    }
+    let next = &AtomicU64::new(state.rounds_done * ROUND_CHUNKS);
+    let stop = &AtomicBool::new(false);
+    let (sender, parts) = mpsc::channel();
+    std::thread::scope(|scope| {
+        scope.spawn(move || {
+            pool.broadcast(|_| walk_parts(walker, settings, next, stop, progress, &sender));
+        });
+        let mut waiting: BTreeMap<u64, RoundPart> = BTreeMap::new();
+        for part in parts {
+            if state.finished {
+                continue;
+            }
+            match waiting.entry(part.round) {
+                Entry::Vacant(v) => {
+                    v.insert(part);
+                }
+                Entry::Occupied(mut o) => {
+                    let whole = o.get_mut();
+                    whole.result.merge(&part.result);
+                    whole.chunks += part.chunks;
+                }
+            }
+            while waiting.get(&state.rounds_done).is_some_and(|p| p.chunks == settings.round_len(p.round)) {
+                let done = waiting.remove(&state.rounds_done).expect("the round is complete");
+                state.result.merge(&done.result);
+                state.rounds_done += 1;
+                state.finished = state.rounds_done >= settings.rounds();
+                let go_on = after_round(state);
+                if !matches!(go_on, Ok(true)) {
+                    state.finished = true;
+                }
+                if state.finished {
+                    stop.store(true, Ordering::Relaxed);
+                    go_on?;
+                    break;
+                }
+            }
+        }
+        Ok(())
+    })
+}
+
+/// One pool thread's share of [`run_case`]: takes the shard's next chunk until there is none
+/// or the case stops, and sends each round's part when it moves past it.
+fn walk_parts(
+    walker: &dyn CaseWalker,
+    settings: &RunSettings,
+    next: &AtomicU64,
+    stop: &AtomicBool,
+    progress: &ProgressBar,
+    sender: &mpsc::Sender<RoundPart>,
+) {
+    let mut part: Option<RoundPart> = None;
+    while !stop.load(Ordering::Relaxed) {
+        let k = next.fetch_add(1, Ordering::Relaxed);
+        let Some(chunk) = settings.shard_chunk(k) else { break };
+        let round = k / ROUND_CHUNKS;
+        if let Some(done) = part.take_if(|p| p.round != round) {
+            // The receiver outlives the pool's threads; an error here means it panicked.
+            let _ = sender.send(done);
+        }
+        let p = part.get_or_insert_with(|| RoundPart { round, chunks: 0, result: walker.empty() });
+        walker.walk_chunk(chunk, &mut p.result);
+        p.chunks += 1;
+        progress.inc(settings.chunk_photons(chunk));
+    }
+    if let Some(done) = part {
+        let _ = sender.send(done);
+    }
 }

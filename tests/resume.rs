@@ -92,15 +92,21 @@ fn precision_targets_stop_early_and_deterministically() {
     let config = smithwalk::config::Config::parse(toml).unwrap();
     let one = smithwalk::simulate(&config, Some(1), false).unwrap();
     let two = smithwalk::simulate(&config, Some(2), false).unwrap();
+    // More threads than a round has chunks (32): parts of later rounds are walked before the
+    // stopping round is complete, and must be dropped.
+    let many = smithwalk::simulate(&config, Some(40), false).unwrap();
     let photons = one.results[0].photons();
     assert_eq!(photons, two.results[0].photons(), "the stopping round depends on threads");
+    assert_eq!(photons, many.results[0].photons(), "the stopping round depends on threads");
     assert!(photons < 20_000_000, "the target did not stop the case early");
     let albedos = one.results[0].albedo_stderrs(2);
     assert!(!albedos.is_empty() && albedos.iter().all(|&(mean, se)| se <= 0.002 * mean), "{albedos:?}");
     // E2 ~ 0.24 at this setting needs about (1-p)/(p r^2) ≈ 8e5 photons: it stopped near there.
     assert!(photons > 400_000, "{photons}");
-    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let (a, b, c) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
     smithwalk::write_outputs(&one, &config, a.path()).unwrap();
     smithwalk::write_outputs(&two, &config, b.path()).unwrap();
+    smithwalk::write_outputs(&many, &config, c.path()).unwrap();
     assert!(tables(a.path()) == tables(b.path()));
+    assert!(tables(a.path()) == tables(c.path()));
 }
