@@ -129,20 +129,22 @@ enum Command {
         out: Option<PathBuf>,
     },
     /// Measure the walk's throughput on the reference cases (paths/s per core, ns per
-    /// facet interaction, and the 1 -> 2 thread scaling).
+    /// facet interaction, the 1 -> 2 thread scaling, and two independent 1-thread runs at
+    /// once as its ceiling on this machine).
     Bench {
         /// Photons per case and thread count.
         #[arg(long, default_value_t = 4_000_000)]
         paths: u64,
-        /// Measurements per case and thread count, alternating 1 and 2 threads; the fastest
-        /// of each is reported (a shared machine only ever slows a run down).
+        /// Measurements per case and thread count, alternating 1 thread, 2 threads and two
+        /// 1-thread runs at once; the fastest of each is reported (a shared machine only ever
+        /// slows a run down).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
     },
 }
 
 fn bench(paths: u64, repeats: usize) -> Result<()> {
-    use smithwalk::bench::{CASES, Throughput, measure};
+    use smithwalk::bench::{CASES, Throughput, measure, measure_pair};
     // The reference configurations with this photon count are checked before the table starts.
     smithwalk::bench::case_config(0, paths)?;
     if repeats == 0 {
@@ -150,24 +152,30 @@ fn bench(paths: u64, repeats: usize) -> Result<()> {
     }
     let cores = std::thread::available_parallelism().map_or(1, usize::from);
     let mut out = std::io::stdout().lock();
-    let header =
-        format!("{:<36} {:>14} {:>12} {:>10} {:>14}", "case", "paths/s/core", "ns/bounce", "bounces", "scaling 1->2");
+    let header = format!(
+        "{:<36} {:>14} {:>12} {:>10} {:>14} {:>14}",
+        "case", "paths/s/core", "ns/bounce", "bounces", "scaling 1->2", "two 1-thread"
+    );
     if !print_line(&mut out, &header)? {
         return Ok(());
     }
     for (i, (label, _, _)) in CASES.iter().enumerate() {
         let (mut one, mut two): (Option<Throughput>, Option<Throughput>) = (None, None);
+        let mut pair: Option<f64> = None;
         for _ in 0..repeats {
             one = Some(measure(i, paths, 1)?.fastest(one));
             if cores >= 2 {
                 two = Some(measure(i, paths, 2)?.fastest(two));
+                pair = Some(measure_pair(i, paths)?.max(pair.unwrap_or(0.0)));
             }
         }
         let one = one.expect("at least one measurement");
-        let scaling = two
-            .map_or("n/a (1 core)".to_string(), |two| format!("{:.2}x", two.paths_per_second / one.paths_per_second));
+        let factor = |rate: Option<f64>| {
+            rate.map_or("n/a (1 core)".to_string(), |rate| format!("{:.2}x", rate / one.paths_per_second))
+        };
+        let (scaling, ceiling) = (factor(two.map(|t| t.paths_per_second)), factor(pair));
         let row = format!(
-            "{label:<36} {:>14.3e} {:>12.1} {:>10.3} {scaling:>14}",
+            "{label:<36} {:>14.3e} {:>12.1} {:>10.3} {scaling:>14} {ceiling:>14}",
             one.per_core(),
             one.ns_per_interaction(),
             one.interactions_per_path
