@@ -136,7 +136,7 @@ fn a_wrong_lobe_is_rejected() {
 }
 
 #[test]
-#[ignore = "heavy: 10^9 photons per case, about 10 minutes on 2 cores"]
+#[ignore = "heavy: 10^9 photons per case, about 3 minutes on 2 cores"]
 fn order_one_albedo_to_four_decimals() {
     // At 10^9 photons the SE is about 1.5e-5, so agreement to 4 decimals (|diff| < 5e-5) is a
     // 3-sigma statement; the same quadrature references as above.
