@@ -13,7 +13,8 @@
 //! * [`facet`]: the micro-BSDF of a single facet (conductor, dielectric, Lambertian, Hammon);
 //! * [`walk`]: the random walk of Heitz et al. 2016 that composes them;
 //! * [`single`]: exact single scattering, the walk's order-1 oracle;
-//! * [`slope`]: closed-form GGX masses of slope-space polygons (exact histogram oracles);
+//! * [`slope`]: closed-form GGX masses and visible-normal probabilities of slope-space
+//!   polygons (exact histogram oracles);
 //! * [`nee`]: next-event estimation, a second estimator of the walk's lobes;
 //! * [`chain`]: height-free chains of visible-normal scatterings, with a visibility model;
 //! * [`wang`]: the position-free models of Wang et al. 2022 as chain visibilities;
