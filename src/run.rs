@@ -469,7 +469,8 @@ fn walk_parts(
         let Some(chunk) = settings.shard_chunk(k) else { break };
         let round = k / ROUND_CHUNKS;
         if let Some(done) = part.take_if(|p| p.round != round) {
-            // The receiver outlives the pool's threads; an error here means it panicked.
+            // The receiver is gone only when the calling thread stopped on an error or a
+            // panic, and then no part is wanted.
             let _ = sender.send(done);
         }
         let p = part.get_or_insert_with(|| RoundPart { round, chunks: 0, result: walker.empty() });
