@@ -77,12 +77,10 @@ pub fn measure(case: usize, paths: u64, threads: usize) -> Result<Throughput> {
 /// 2 where the two cores share a physical core, caches or memory bandwidth, or other tenants
 /// take part of them).
 pub fn measure_pair(case: usize, paths: u64) -> Result<f64> {
-    let config = case_config(case, paths)?;
-    let run = || simulate(&config, Some(1), false).map(|sim| sim.wall_seconds);
     let (a, b) = std::thread::scope(|scope| {
-        let other = scope.spawn(run);
-        let mine = run();
-        (mine, other.join().expect("a bench run panicked"))
+        let other = scope.spawn(|| measure(case, paths, 1));
+        (measure(case, paths, 1), other.join().expect("a bench run panicked"))
     });
-    Ok(2.0 * paths as f64 / a?.max(b?))
+    // Both runs walk `paths`: the pair's rate is twice the slower one's.
+    Ok(2.0 * a?.paths_per_second.min(b?.paths_per_second))
 }

@@ -32,18 +32,20 @@ theta_deg = [10, 70]
 phi_deg = 25
 "#;
 
-fn outputs(threads: usize, dir: &Path) -> (Vec<u8>, Vec<u8>) {
-    let config = Config::parse(CONFIG).unwrap();
-    let sim = smithwalk::simulate(&config, Some(threads), false).unwrap();
-    smithwalk::write_outputs(&sim, &config, dir).unwrap();
+/// lobes.csv and summary.csv of `config` run on `threads` threads, written into `dir`.
+fn outputs(config: &Config, threads: usize, dir: &Path) -> (Vec<u8>, Vec<u8>) {
+    let sim = smithwalk::simulate(config, Some(threads), false).unwrap();
+    assert_eq!(sim.results[0].photons(), config.paths);
+    smithwalk::write_outputs(&sim, config, dir).unwrap();
     (std::fs::read(dir.join("lobes.csv")).unwrap(), std::fs::read(dir.join("summary.csv")).unwrap())
 }
 
 #[test]
 fn one_and_two_threads_give_identical_files() {
+    let config = Config::parse(CONFIG).unwrap();
     let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
-    let one = outputs(1, a.path());
-    let two = outputs(2, b.path());
+    let one = outputs(&config, 1, a.path());
+    let two = outputs(&config, 2, b.path());
     assert!(one.0 == two.0, "lobes.csv differs between 1 and 2 threads");
     assert!(one.1 == two.1, "summary.csv differs between 1 and 2 threads");
     // The run is RGB with splitting: the channel column is there and nothing is NaN or inf.
@@ -59,13 +61,7 @@ fn one_and_two_threads_give_identical_files() {
 fn rounds_walked_ahead_give_identical_files() {
     let toml = "paths = 1_200_000\nseed = 5\n[surface]\nalpha = 0.7\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 50\n";
     let config = Config::parse(toml).unwrap();
-    let tables = |threads| {
-        let dir = tempfile::tempdir().unwrap();
-        let sim = smithwalk::simulate(&config, Some(threads), false).unwrap();
-        assert_eq!(sim.results[0].photons(), 1_200_000);
-        smithwalk::write_outputs(&sim, &config, dir.path()).unwrap();
-        (std::fs::read(dir.path().join("lobes.csv")).unwrap(), std::fs::read(dir.path().join("summary.csv")).unwrap())
-    };
+    let tables = |threads| outputs(&config, threads, tempfile::tempdir().unwrap().path());
     let one = tables(1);
     assert!(one == tables(2), "2 threads differ from 1");
     assert!(one == tables(37), "37 threads differ from 1");
