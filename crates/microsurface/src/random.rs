@@ -21,6 +21,13 @@ pub fn exp1<R: Rng + ?Sized>(rng: &mut R) -> f64 {
     rand_distr::Exp1.sample(rng)
 }
 
+/// A standard normal variate, drawn by the ziggurat method (Marsaglia & Tsang 2000): exact in
+/// distribution, mostly without a logarithm.
+#[inline]
+pub fn normal1<R: Rng + ?Sized>(rng: &mut R) -> f64 {
+    rand_distr::StandardNormal.sample(rng)
+}
+
 /// Sectors of the azimuth table: the top `SECTOR_BITS` bits of a draw pick a sector of the
 /// circle, the next 53 bits the offset inside it.
 const SECTOR_BITS: u32 = 8;
