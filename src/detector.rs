@@ -350,6 +350,9 @@ pub struct Detector<const C: usize> {
     unit_hits: Vec<u32>,
     /// Photons counted in `unit_hits`.
     unsettled: u32,
+    /// Scratch space of [`Detector::add_split_photon`], kept so that no photon allocates: a
+    /// split photon's deposits, each twice (in slot 0 and in its order's slot), keyed.
+    keyed: Vec<(usize, [f64; C])>,
 }
 
 /// Adds photons of weight 1 counted per bin, `hits[slot * bins + i]`, to the bins' tallies.
@@ -396,6 +399,7 @@ impl<const C: usize> Detector<C> {
             last_whole: ([0.0; C], Contribution::of(&[0.0; C])),
             unit_hits: Vec::new(),
             unsettled: 0,
+            keyed: Vec::new(),
         }
     }
 
@@ -516,25 +520,29 @@ impl<const C: usize> Detector<C> {
     /// per (slot, hemisphere) before squaring, so variances stay per photon (§4.6).
     fn add_split_photon(&mut self) {
         let bins = self.grid.bins();
-        let mut keyed: Vec<(usize, usize, usize, [f64; C])> = Vec::with_capacity(2 * self.pending.len());
+        // Keyed by `(slot, hemisphere, bin)` as one number, `(2 slot + hemisphere) bins + bin`,
+        // so that a key divided by `bins` is the (slot, hemisphere) of the albedo tallies.
+        self.keyed.clear();
         for d in &self.pending {
             let i = d.hemisphere as usize * bins + d.bin;
-            keyed.push((0, d.hemisphere as usize, i, d.weight));
-            keyed.push((d.slot, d.hemisphere as usize, i, d.weight));
+            self.keyed.push((i, d.weight));
+            self.keyed.push((2 * d.slot * bins + i, d.weight));
         }
-        keyed.sort_by_key(|&(slot, hemi, i, _)| (slot, hemi, i));
+        // Stable: deposits that share a key are summed in the order they escaped.
+        self.keyed.sort_by_key(|&(key, _)| key);
         let mut bin_sum = [0.0; C];
         let mut hemi_sum = [0.0; C];
-        for (n, &(slot, hemi, i, w)) in keyed.iter().enumerate() {
+        for (n, &(key, w)) in self.keyed.iter().enumerate() {
             accumulate(&mut bin_sum, &w);
             accumulate(&mut hemi_sum, &w);
-            let next = keyed.get(n + 1);
-            if next.is_none_or(|&(s, h, j, _)| (s, h, j) != (slot, hemi, i)) {
+            let (slot, i) = (key / (2 * bins), key % (2 * bins));
+            let next = self.keyed.get(n + 1).map(|&(k, _)| k);
+            if next != Some(key) {
                 self.tallies.orders[slot].bins[i].add(&bin_sum);
                 bin_sum = [0.0; C];
             }
-            if next.is_none_or(|&(s, h, _, _)| (s, h) != (slot, hemi)) {
-                self.tallies.orders[slot].albedo[hemi].add(&hemi_sum);
+            if next.map(|k| k / bins) != Some(key / bins) {
+                self.tallies.orders[slot].albedo[i / bins].add(&hemi_sum);
                 hemi_sum = [0.0; C];
             }
         }
