@@ -1,9 +1,12 @@
 //! `smithwalk bench`: throughput of the walk on the reference cases of the throughput issue,
 //! reported as paths per second per core and nanoseconds per facet interaction, plus the
 //! scaling from 1 to 2 threads and, as its ceiling on this machine, the throughput of two
-//! independent 1-thread runs at the same time.
+//! independent 1-thread runs at the same time, and how many cores a 2-thread run keeps busy.
+
+use std::time::{Duration, Instant};
 
 use anyhow::Result;
+use rustix::time::{ClockId, clock_gettime};
 
 use crate::config::Config;
 use crate::simulate;
@@ -35,6 +38,11 @@ pub struct Throughput {
     pub paths_per_second: f64,
     pub interactions_per_path: f64,
     pub threads: usize,
+    /// CPU time of the process over wall time during the run (setup included): the cores it
+    /// kept busy. Below the thread count by the time threads wait for work; how fast each
+    /// busy core went is in `paths_per_second`. (Idle pool threads spin briefly before they
+    /// sleep, which counts as busy; at the end of a run that is well below a chunk's time.)
+    pub busy_cores: f64,
 }
 
 impl Throughput {
@@ -59,7 +67,9 @@ impl Throughput {
 /// Runs a reference case on `threads` threads.
 pub fn measure(case: usize, paths: u64, threads: usize) -> Result<Throughput> {
     let config = case_config(case, paths)?;
+    let (cpu, wall) = (process_cpu_time(), Instant::now());
     let sim = simulate(&config, Some(threads), false)?;
+    let busy_cores = (process_cpu_time() - cpu).as_secs_f64() / wall.elapsed().as_secs_f64();
     let interactions = match &sim.results[0] {
         crate::run::CaseResult::Mono(d) => d.tallies.interactions,
         crate::run::CaseResult::Rgb(d) => d.tallies.interactions,
@@ -68,7 +78,14 @@ pub fn measure(case: usize, paths: u64, threads: usize) -> Result<Throughput> {
         paths_per_second: paths as f64 / sim.wall_seconds,
         interactions_per_path: interactions as f64 / paths as f64,
         threads: sim.threads,
+        busy_cores,
     })
+}
+
+/// CPU time used so far by all threads of this process, the finished ones included.
+fn process_cpu_time() -> Duration {
+    let t = clock_gettime(ClockId::ProcessCPUTime);
+    Duration::new(t.tv_sec.unsigned_abs(), t.tv_nsec.unsigned_abs() as u32)
 }
 
 /// Two runs of a reference case on 1 thread each, at the same time: paths per second of the

@@ -129,8 +129,8 @@ enum Command {
         out: Option<PathBuf>,
     },
     /// Measure the walk's throughput on the reference cases (paths/s per core, ns per
-    /// facet interaction, the 1 -> 2 thread scaling, and two independent 1-thread runs at
-    /// once as its ceiling on this machine).
+    /// facet interaction, the 1 -> 2 thread scaling, two independent 1-thread runs at once as
+    /// its ceiling on this machine, and the cores the 2-thread run keeps busy).
     Bench {
         /// Photons per case and thread count.
         #[arg(long, default_value_t = 4_000_000)]
@@ -153,8 +153,8 @@ fn bench(paths: u64, repeats: usize) -> Result<()> {
     let cores = std::thread::available_parallelism().map_or(1, usize::from);
     let mut out = std::io::stdout().lock();
     let header = format!(
-        "{:<36} {:>14} {:>12} {:>10} {:>14} {:>14}",
-        "case", "paths/s/core", "ns/bounce", "bounces", "scaling 1->2", "two 1-thread"
+        "{:<36} {:>14} {:>12} {:>10} {:>14} {:>14} {:>12}",
+        "case", "paths/s/core", "ns/bounce", "bounces", "scaling 1->2", "two 1-thread", "busy cores"
     );
     if !print_line(&mut out, &header)? {
         return Ok(());
@@ -174,8 +174,9 @@ fn bench(paths: u64, repeats: usize) -> Result<()> {
             rate.map_or("n/a (1 core)".to_string(), |rate| format!("{:.2}x", rate / one.paths_per_second))
         };
         let (scaling, ceiling) = (factor(two.map(|t| t.paths_per_second)), factor(pair));
+        let busy = two.map_or("n/a".to_string(), |t| format!("{:.3}", t.busy_cores));
         let row = format!(
-            "{label:<36} {:>14.3e} {:>12.1} {:>10.3} {scaling:>14} {ceiling:>14}",
+            "{label:<36} {:>14.3e} {:>12.1} {:>10.3} {scaling:>14} {ceiling:>14} {busy:>12}",
             one.per_core(),
             one.ns_per_interaction(),
             one.interactions_per_path
