@@ -537,12 +537,20 @@ impl<const C: usize> Detector<C> {
             accumulate(&mut hemi_sum, &w);
             let (slot, i) = (key / (2 * bins), key % (2 * bins));
             let next = self.keyed.get(n + 1).map(|&(k, _)| k);
+            let order = &mut self.tallies.orders[slot];
+            let mut bin_contribution = None;
             if next != Some(key) {
-                self.tallies.orders[slot].bins[i].add(&bin_sum);
+                let c = Contribution::of(&bin_sum);
+                order.bins[i].add_contribution(&c);
+                bin_contribution = Some((bin_sum, c));
                 bin_sum = [0.0; C];
             }
             if next.map(|k| k / bins) != Some(key / bins) {
-                self.tallies.orders[slot].albedo[i / bins].add(&hemi_sum);
+                // A hemisphere reached through this bin alone has the same sum: converted once.
+                match bin_contribution {
+                    Some((sum, c)) if sum == hemi_sum => order.albedo[i / bins].add_contribution(&c),
+                    _ => order.albedo[i / bins].add(&hemi_sum),
+                }
                 hemi_sum = [0.0; C];
             }
         }
