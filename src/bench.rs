@@ -70,10 +70,7 @@ pub fn measure(case: usize, paths: u64, threads: usize) -> Result<Throughput> {
     let (cpu, wall) = (process_cpu_time(), Instant::now());
     let sim = simulate(&config, Some(threads), false)?;
     let busy_cores = (process_cpu_time() - cpu).as_secs_f64() / wall.elapsed().as_secs_f64();
-    let interactions = match &sim.results[0] {
-        crate::run::CaseResult::Mono(d) => d.tallies.interactions,
-        crate::run::CaseResult::Rgb(d) => d.tallies.interactions,
-    };
+    let interactions = sim.results[0].interactions();
     Ok(Throughput {
         paths_per_second: paths as f64 / sim.wall_seconds,
         interactions_per_path: interactions as f64 / paths as f64,

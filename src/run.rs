@@ -149,6 +149,14 @@ impl CaseResult {
         }
     }
 
+    /// The facet interactions of all its photons' rays.
+    pub fn interactions(&self) -> u64 {
+        match self {
+            CaseResult::Mono(d) => d.tallies.interactions,
+            CaseResult::Rgb(d) => d.tallies.interactions,
+        }
+    }
+
     /// The albedo of order slot `slot` into `hemisphere` (channel 0) and its standard error;
     /// zero for slots no light reached.
     pub fn albedo(&self, slot: usize, hemisphere: Hemisphere) -> (f64, f64) {
