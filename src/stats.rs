@@ -20,6 +20,15 @@ pub struct WeightedBin {
     pub second_moment: f64,
 }
 
+impl WeightedBin {
+    /// The bin that `count` of `samples` unit-weight samples fell in: mean and second moment
+    /// are both `count / samples` (the multinomial case).
+    pub fn of_count(count: u64, samples: u64) -> Self {
+        let p = count as f64 / samples as f64;
+        Self { mean: p, second_moment: p }
+    }
+}
+
 /// One cell of a test after pooling, kept for the diagnostic table.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cell {

@@ -107,10 +107,9 @@ fn equiprobable(samples: &[f64], quantile: impl Fn(f64) -> f64) -> smithwalk::st
         let k = edges.partition_point(|e| e <= x).clamp(1, BINS) - 1;
         counts[k] += 1;
     }
-    let n = samples.len() as f64;
-    let observed: Vec<WeightedBin> =
-        counts.iter().map(|&k| WeightedBin { mean: k as f64 / n, second_moment: k as f64 / n }).collect();
-    chi_square(&observed, &[1.0 / BINS as f64; BINS], samples.len() as u64, 5.0)
+    let n = samples.len() as u64;
+    let observed: Vec<WeightedBin> = counts.iter().map(|&k| WeightedBin::of_count(k, n)).collect();
+    chi_square(&observed, &[1.0 / BINS as f64; BINS], n, 5.0)
 }
 
 #[test]

@@ -133,8 +133,7 @@ fn triangulated_grid_test(r: Roughness, w: DVec3, seed: u128, expected_of: impl 
         };
         counts[cell] += 1;
     }
-    let observed: Vec<WeightedBin> =
-        counts.iter().map(|&c| c as f64 / N as f64).map(|p| WeightedBin { mean: p, second_moment: p }).collect();
+    let observed: Vec<WeightedBin> = counts.iter().map(|&c| WeightedBin::of_count(c, N)).collect();
     chi_square(&observed, &expected, N, 5.0)
 }
 

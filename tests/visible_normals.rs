@@ -76,7 +76,7 @@ fn sampled<N: Ndf>(ndf: &N, normals: Normals, w: DVec3, seed: u64) -> Vec<Weight
         }
         counts[bin_of(m)] += 1;
     }
-    counts.iter().map(|&c| c as f64 / SAMPLES as f64).map(|p| WeightedBin { mean: p, second_moment: p }).collect()
+    counts.iter().map(|&c| WeightedBin::of_count(c, SAMPLES)).collect()
 }
 
 /// (theta_deg, phi_deg) of the viewing directions: above the horizon, and below it on both
@@ -211,11 +211,7 @@ fn beckmann_visible_slope_matches_its_density() {
             };
             counts[cell] += 1;
         }
-        let observed: Vec<WeightedBin> = counts
-            .iter()
-            .map(|&c| c as f64 / SLOPES as f64)
-            .map(|p| WeightedBin { mean: p, second_moment: p })
-            .collect();
+        let observed: Vec<WeightedBin> = counts.iter().map(|&c| WeightedBin::of_count(c, SLOPES)).collect();
         let test = chi_square(&observed, &expect, SLOPES, 5.0);
         assert!(test.p_value > level, "mu {mu}: p = {}\n{}", test.p_value, test.worst_cells(8));
     }
