@@ -4,7 +4,7 @@
 //! throughput is the time per bounce. `smithwalk bench` prints the same cases, plus the
 //! 1 -> 2 thread scaling.
 
-use smithwalk::bench::{CASES, case_config};
+use smithwalk::engine::bench::{CASES, case_config};
 
 const PATHS: u64 = 100_000;
 
@@ -14,7 +14,7 @@ fn main() {
 
 /// Runs a reference case on 1 thread; returns its number of facet interactions (the same for
 /// every run: the seed is fixed).
-fn walk_case(config: &smithwalk::config::Config) -> u64 {
+fn walk_case(config: &smithwalk::setup::config::Config) -> u64 {
     smithwalk::simulate(divan::black_box(config), Some(1), false).expect("runs").results[0].interactions()
 }
 

@@ -8,13 +8,14 @@ use std::time::Duration;
 
 use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
-use smithwalk::checkpoint::{self, Checkpointer};
-use smithwalk::compare::Model;
-use smithwalk::config::Config;
-use smithwalk::lut::LutConfig;
-use smithwalk::output::{EnergyBalance, prepare_dir};
-use smithwalk::run::{Estimator, Shard};
-use smithwalk::shard::write_shard;
+use smithwalk::atomic::prepare_dir;
+use smithwalk::engine::checkpoint::{self, Checkpointer};
+use smithwalk::engine::run::{Estimator, Shard};
+use smithwalk::engine::shard::write_shard;
+use smithwalk::exports::lut::LutConfig;
+use smithwalk::io::output::EnergyBalance;
+use smithwalk::setup::config::Config;
+use smithwalk::setup::config::Model;
 use smithwalk::{RunOptions, Simulation};
 
 #[derive(Parser)]
@@ -110,7 +111,7 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
         /// Grid points per axis of the half-vector square, per incident angle.
-        #[arg(long, default_value_t = smithwalk::rgl::DEFAULT_RESOLUTION)]
+        #[arg(long, default_value_t = smithwalk::exports::rgl::DEFAULT_RESOLUTION)]
         resolution: usize,
     },
     /// Measure energy-compensation tables (directional albedo per order, its average) from a
@@ -144,9 +145,9 @@ enum Command {
 }
 
 fn bench(paths: u64, repeats: usize) -> Result<()> {
-    use smithwalk::bench::{CASES, Throughput, measure, measure_pair};
+    use smithwalk::engine::bench::{CASES, Throughput, measure, measure_pair};
     // The reference configurations with this photon count are checked before the table starts.
-    smithwalk::bench::case_config(0, paths)?;
+    smithwalk::engine::bench::case_config(0, paths)?;
     if repeats == 0 {
         bail!("`--repeats` = 0 is not allowed: at least 1 measurement per case");
     }
@@ -215,7 +216,7 @@ fn run(args: RunArgs) -> Result<()> {
     let config = run_config(&args)?;
     let out = args.out.clone().unwrap_or_else(|| default_out(&args.config));
     #[cfg(feature = "mpi")]
-    if let Some(ranks) = smithwalk::ranks::Ranks::join()? {
+    if let Some(ranks) = smithwalk::engine::ranks::Ranks::join()? {
         let result = run_ranks(&args, &config, &out, &ranks);
         ranks.abort_on_error(result);
         return Ok(());
@@ -297,7 +298,7 @@ fn finish_run(
     if let Some(c) = &config.compare {
         let models =
             c.models.iter().map(|m| Model::parse(m).map_err(anyhow::Error::msg)).collect::<Result<Vec<_>>>()?;
-        print!("{}", smithwalk::compare::compare(out, &models, c.paths, threads)?);
+        print!("{}", smithwalk::analysis::compare::compare(out, &models, c.paths, threads)?);
     }
     Ok(())
 }
@@ -306,7 +307,7 @@ fn finish_run(
 /// `OUT/rank-R-of-N`; rank 0 merges every rank's accumulators and writes the outputs. The
 /// checkpoints go only when the outputs are written.
 #[cfg(feature = "mpi")]
-fn run_ranks(args: &RunArgs, config: &Config, out: &Path, ranks: &smithwalk::ranks::Ranks) -> Result<()> {
+fn run_ranks(args: &RunArgs, config: &Config, out: &Path, ranks: &smithwalk::engine::ranks::Ranks) -> Result<()> {
     use anyhow::Context as _;
     if let Some(s) = args.shard {
         bail!("`--shard` = {}/{} is not allowed under mpirun: the ranks share the work", s.index, s.count);
@@ -320,8 +321,8 @@ fn run_ranks(args: &RunArgs, config: &Config, out: &Path, ranks: &smithwalk::ran
     let threads = args.threads.unwrap_or_else(|| ranks.default_threads());
     let args = &RunArgs { threads: Some(threads), ..args.clone() };
     let (sim, checkpoints) = walk(args, config, shard, &dir, ranks.is_root())?;
-    if let Some(shards) = ranks.gather(smithwalk::shard::encode(&sim, config, shard)?) {
-        let (config, sim) = smithwalk::shard::merge_bytes(&shards)?;
+    if let Some(shards) = ranks.gather(smithwalk::engine::shard::encode(&sim, config, shard)?) {
+        let (config, sim) = smithwalk::engine::shard::merge_bytes(&shards)?;
         let written = smithwalk::write_outputs(&sim, &config, out)?;
         finish_run(&sim, &config, out, &written, args.threads)?;
     }
@@ -352,8 +353,8 @@ fn lut(config_path: &Path, paths: Option<u64>, threads: Option<usize>, out: Opti
     check_threads(threads)?;
     let out = out.unwrap_or_else(|| default_out(config_path));
     prepare_dir(&out)?;
-    let lut = smithwalk::lut::build(&config, threads, true)?;
-    let written = smithwalk::lut::write(&lut, &out)?;
+    let lut = smithwalk::exports::lut::build(&config, threads, true)?;
+    let written = smithwalk::exports::lut::write(&lut, &out)?;
     let worst = lut.tables.iter().flat_map(|t| t.e_stderr.iter()).fold(0.0_f64, |a, &b| a.max(b));
     println!(
         "{} cells, {} photons in {:.2} s; largest standard error {worst:.2e}",
@@ -368,7 +369,7 @@ fn lut(config_path: &Path, paths: Option<u64>, threads: Option<usize>, out: Opti
 }
 
 fn merge(shards: &[PathBuf], out: &Path) -> Result<()> {
-    let (config, sim) = smithwalk::shard::merge(shards)?;
+    let (config, sim) = smithwalk::engine::shard::merge(shards)?;
     prepare_dir(out)?;
     let written = smithwalk::write_outputs(&sim, &config, out)?;
     report(&sim, &config, &written)
@@ -438,18 +439,18 @@ fn main() -> ExitCode {
         }
         Command::Merge { shards, out } => merge(&shards, &out),
         Command::Compare { run_dir, models, paths, threads } => {
-            smithwalk::compare::compare(&run_dir, &models, paths, threads).map(|report| print!("{report}"))
+            smithwalk::analysis::compare::compare(&run_dir, &models, paths, threads).map(|report| print!("{report}"))
         }
         Command::Lut { config, paths, threads, out } => lut(&config, paths, threads, out),
-        Command::Plot { run_dir } => smithwalk::plot::plot(&run_dir)
+        Command::Plot { run_dir } => smithwalk::exports::plot::plot(&run_dir)
             .map(|written| println!("wrote {} files; open {}", written.len(), run_dir.join("index.html").display())),
         Command::Merl { run_dir, out } => {
             let out = out.unwrap_or_else(|| run_dir.join("brdf.binary"));
-            smithwalk::merl::export(&run_dir, &out).map(|p| println!("wrote {}", p.display()))
+            smithwalk::exports::merl::export(&run_dir, &out).map(|p| println!("wrote {}", p.display()))
         }
         Command::Rgl { run_dir, out, resolution } => {
             let out = out.unwrap_or_else(|| run_dir.join("brdf.bsdf"));
-            smithwalk::rgl::export(&run_dir, &out, resolution).map(|p| println!("wrote {}", p.display()))
+            smithwalk::exports::rgl::export(&run_dir, &out, resolution).map(|p| println!("wrote {}", p.display()))
         }
         Command::Bench { paths, repeats } => bench(paths, repeats),
     };

@@ -49,7 +49,7 @@ fn a_run_with_a_compare_section_measures_the_models() {
     let single: Vec<&csv::StringRecord> = rows.iter().filter(|r| &r[model] == "single").collect();
     // 4 conductor lobes (R) and 4 dielectric cases with R and T.
     assert_eq!(single.len(), 12);
-    let level = smithwalk::stats::sidak(0.01, single.len());
+    let level = smithwalk::analysis::stats::sidak(0.01, single.len());
     for r in &single {
         let pv: f64 = r[p].parse().unwrap();
         assert!(pv > level, "single rejected: case {} {}: p = {pv}", &r[case], &r[hemi]);

@@ -7,7 +7,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use smithwalk::config::Config;
+use smithwalk::setup::config::Config;
 
 const CONFIG: &str = r#"
 paths = 40_000
@@ -170,7 +170,7 @@ fn a_good_run_writes_all_three_files() {
 
 #[test]
 fn sweeps_parse_unambiguously_and_round_trip() {
-    use smithwalk::config::{Alpha, OneOrMany};
+    use smithwalk::setup::config::{Alpha, OneOrMany};
     let parse = |alpha: &str| {
         let text = GOOD.replace("alpha = 0.5", &format!("alpha = {alpha}"));
         let config = Config::parse(&text).unwrap();

@@ -12,8 +12,8 @@
 mod common;
 
 use common::{CONDUCTOR_ORDERS, albedo, check_orders, mono, simulate};
-use smithwalk::detector::Hemisphere;
-use smithwalk::output::EnergyBalance;
+use smithwalk::engine::detector::Hemisphere;
+use smithwalk::io::output::EnergyBalance;
 
 #[test]
 fn white_furnace() {

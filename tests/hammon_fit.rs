@@ -8,12 +8,12 @@
 //!   approximation fitted to a different walk (symmetric Lambda, rejection normals), so the test
 //!   records the measured all-order albedo difference and only asserts it stays below 10 %.
 
-use smithwalk::cases::expand;
-use smithwalk::config::Config;
-use smithwalk::detector::Grid;
-use smithwalk::models::{HammonFitPart, hammon_fit_bins};
+use smithwalk::analysis::models::{HammonFitPart, hammon_fit_bins};
+use smithwalk::engine::detector::Grid;
+use smithwalk::setup::cases::expand;
+use smithwalk::setup::config::Config;
 
-fn case(alpha: f64, f0: f64, albedo: f64, theta: f64) -> (smithwalk::cases::Case, String) {
+fn case(alpha: f64, f0: f64, albedo: f64, theta: f64) -> (smithwalk::setup::cases::Case, String) {
     let toml = format!(
         "paths = 1_000_000\nseed = 21\n[surface]\nalpha = {alpha}\n[material]\nkind = \"hammon\"\nf0 = {f0}\nalbedo = {albedo}\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 16\nphi_bins = 32\nmax_order = 3\n"
     );
@@ -36,7 +36,7 @@ fn the_fit_beside_the_simulation() {
     let grid = Grid { cos_bins: 16, phi_bins: 32 };
     let fit: f64 = hammon_fit_bins(&c, &grid, HammonFitPart::All, 1e-12).unwrap().iter().sum();
     let sim = smithwalk::simulate(&Config::parse(&toml).unwrap(), Some(2), false).unwrap();
-    let e = smithwalk::output::EnergyBalance::from_result(&sim.results[0]);
+    let e = smithwalk::io::output::EnergyBalance::from_result(&sim.results[0]);
     let measured = e.reflected[0];
     println!("hammon facet alpha 0.5, 30 deg: simulated albedo {measured:.4}, Hammon's fit {fit:.4}");
     assert!((fit - measured).abs() < 0.1 * measured, "fit {fit} vs simulation {measured}");

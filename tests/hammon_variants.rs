@@ -9,8 +9,8 @@
 mod common;
 
 use common::{albedo, mono, simulate};
-use smithwalk::detector::Hemisphere;
-use smithwalk::output::EnergyBalance;
+use smithwalk::engine::detector::Hemisphere;
+use smithwalk::io::output::EnergyBalance;
 
 fn e1(surface_extra: &str, alpha: f64, theta: f64, seed: u64) -> (f64, f64, EnergyBalance) {
     let toml = format!(

@@ -7,7 +7,7 @@
 
 mod common;
 
-use smithwalk::config::Config;
+use smithwalk::setup::config::Config;
 
 fn csv_without_height(height: &str, file: &str) -> String {
     let toml = format!(

@@ -10,12 +10,12 @@
 //! - the files: the C header compiled by the system C compiler, the Rust source compiled by
 //!   rustc, and the OpenEXR image decoded, all hold the values of lut.csv.
 
-use smithwalk::cases::{Case, expand};
-use smithwalk::detector::{Grid, Hemisphere};
-use smithwalk::lut::{Lut, LutConfig, build};
-use smithwalk::models::single_scattering_bins;
-use smithwalk::quadrature::integrate;
-use smithwalk::stats::sidak;
+use smithwalk::analysis::models::single_scattering_bins;
+use smithwalk::analysis::quadrature::integrate;
+use smithwalk::analysis::stats::sidak;
+use smithwalk::engine::detector::{Grid, Hemisphere};
+use smithwalk::exports::lut::{Lut, LutConfig, build};
+use smithwalk::setup::cases::{Case, expand};
 
 fn lut(toml: &str) -> Lut {
     let config: LutConfig = toml::from_str(toml).expect("test table config parses");
@@ -27,7 +27,7 @@ fn case_at(lut: &Lut, alpha: f64, mu: f64, eta: Option<f64>) -> Case {
     let mut case =
         expand(&lut.config.run_config()).into_iter().find(|c| c.alpha_x == alpha).expect("a case at this alpha");
     if let Some(eta) = eta {
-        case.material = smithwalk::config::MaterialConfig::Dielectric { eta, name: None };
+        case.material = smithwalk::setup::config::MaterialConfig::Dielectric { eta, name: None };
     }
     case.theta_i_deg = mu.acos().to_degrees();
     case
@@ -193,7 +193,7 @@ fn csv_values(dir: &std::path::Path, quantity: &str) -> Vec<f32> {
 fn c_header_rust_source_and_exr_hold_the_csv_values() {
     let lut = lut("table = \"dielectric\"\nmu = 3\nalpha = 2\neta = 2\nmax_order = 2\navg_nodes = 2\npaths = 2000\n");
     let dir = tempfile::tempdir().unwrap();
-    smithwalk::lut::write(&lut, dir.path()).unwrap();
+    smithwalk::exports::lut::write(&lut, dir.path()).unwrap();
     let expected = csv_values(dir.path(), "inside_T_all");
     assert_eq!(expected.len(), 12);
     let printed = |out: std::process::Output| -> Vec<f32> {

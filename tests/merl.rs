@@ -14,8 +14,8 @@
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
-use smithwalk::config::Config;
 use smithwalk::microsurface::DVec3;
+use smithwalk::setup::config::Config;
 
 const CELLS: usize = 90 * 90 * 180;
 
@@ -78,14 +78,14 @@ fn merl_file_read_back_independently_matches_the_simulated_lobes() {
     let sim = smithwalk::simulate(&config, Some(2), false).unwrap();
     let dir = tempfile::tempdir().unwrap();
     smithwalk::write_outputs(&sim, &config, dir.path()).unwrap();
-    let file = smithwalk::merl::export(dir.path(), &dir.path().join("ggx.binary")).unwrap();
+    let file = smithwalk::exports::merl::export(dir.path(), &dir.path().join("ggx.binary")).unwrap();
     let merl = Merl::parse(&std::fs::read(file).unwrap());
 
     let (cos_bins, phi_bins) = (32, 64);
     for case in [5, 10, 15] {
         // theta_i = 20, 40, 60 deg
         let wi = direction((4.0 * case as f64).to_radians().cos(), 0.0);
-        let smithwalk::run::CaseResult::Rgb(d) = &sim.results[case] else { panic!("rgb run") };
+        let smithwalk::engine::run::CaseResult::Rgb(d) = &sim.results[case] else { panic!("rgb run") };
         let n = d.tallies.photons;
         for c in 0..3 {
             let (mut l1, mut noise, mut norm, mut albedo) = (0.0, 0.0, 0.0, 0.0);
@@ -140,7 +140,7 @@ fn merl_export_refuses_runs_that_are_not_one_isotropic_material() {
         let sim = smithwalk::simulate(&config, Some(1), false).unwrap();
         smithwalk::write_outputs(&sim, &config, dir.path()).unwrap();
         let out = dir.path().join("x.binary");
-        let err = smithwalk::merl::export(dir.path(), &out).expect_err(toml).to_string();
+        let err = smithwalk::exports::merl::export(dir.path(), &out).expect_err(toml).to_string();
         assert!(err.contains(expected), "{err}");
         assert!(!out.exists(), "no file on error");
     }

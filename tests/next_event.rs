@@ -24,9 +24,9 @@
 mod common;
 
 use common::{assert_lobes_agree, mono, simulate_with, two_sided_z};
-use smithwalk::detector::Hemisphere;
-use smithwalk::run::Estimator;
-use smithwalk::stats::sidak;
+use smithwalk::analysis::stats::sidak;
+use smithwalk::engine::detector::Hemisphere;
+use smithwalk::engine::run::Estimator;
 
 const CASES: [(&str, &str, &str, &[Hemisphere]); 7] = [
     ("ndf = \"ggx\"\nalpha = 0.8", "kind = \"conductor\"", "theta_deg = 40", &[Hemisphere::R]),

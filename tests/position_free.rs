@@ -18,13 +18,13 @@ mod common;
 use common::{CONDUCTOR_ORDERS, assert_lobes_agree, check_orders, mono, simulate_with, two_sided_z};
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
-use smithwalk::detector::Hemisphere;
+use smithwalk::analysis::stats::sidak;
+use smithwalk::engine::detector::Hemisphere;
+use smithwalk::engine::run::Estimator;
+use smithwalk::io::output::EnergyBalance;
 use smithwalk::microsurface::chain::Visibility;
 use smithwalk::microsurface::position_free::DepthProfile;
 use smithwalk::microsurface::random::exp1;
-use smithwalk::output::EnergyBalance;
-use smithwalk::run::Estimator;
-use smithwalk::stats::sidak;
 
 /// Follows a pattern of depth rates (first: the entering direction, down; then `(rate, up)`)
 /// and returns the absolute probability of escaping at each upward step.

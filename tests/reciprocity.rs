@@ -16,7 +16,7 @@ use microsurface::normals::Normals;
 use microsurface::smith::Smith;
 use microsurface::walk::{EnergyPolicy, Loss, Microsurface, Observer};
 use rand_pcg::Pcg64Mcg;
-use smithwalk::stats::sidak;
+use smithwalk::analysis::stats::sidak;
 use statrs::distribution::{ContinuousCDF, Normal};
 
 const PHOTONS: u64 = 400_000;

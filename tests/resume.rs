@@ -89,7 +89,7 @@ fn resume_refuses_a_checkpoint_of_another_config() {
 #[test]
 fn precision_targets_stop_early_and_deterministically() {
     let toml = "paths = 20_000_000\nseed = 2\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 40\n[detector]\ncos_theta_bins = 4\nphi_bins = 4\n[precision]\ntarget_rel_stderr = 0.002\norders = 2\n";
-    let config = smithwalk::config::Config::parse(toml).unwrap();
+    let config = smithwalk::setup::config::Config::parse(toml).unwrap();
     let one = smithwalk::simulate(&config, Some(1), false).unwrap();
     let two = smithwalk::simulate(&config, Some(2), false).unwrap();
     // More threads than a round has chunks (32): parts of later rounds are walked before the

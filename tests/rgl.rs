@@ -25,9 +25,9 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::io::Write;
 use std::process::{Command, Stdio};
 
-use smithwalk::config::Config;
+use smithwalk::engine::run::CaseResult;
 use smithwalk::microsurface::DVec3;
-use smithwalk::run::CaseResult;
+use smithwalk::setup::config::Config;
 
 const COS_BINS: usize = 32;
 const PHI_BINS: usize = 64;
@@ -184,7 +184,7 @@ fn sweep() -> (smithwalk::Simulation, tempfile::TempDir) {
 fn rgl_file_read_back_independently_and_by_mitsuba_matches_the_simulated_lobes() {
     let (sim, dir) = sweep();
     let n = 64;
-    let path = smithwalk::rgl::export(dir.path(), &dir.path().join("ggx.bsdf"), n).unwrap();
+    let path = smithwalk::exports::rgl::export(dir.path(), &dir.path().join("ggx.bsdf"), n).unwrap();
     let file = TensorFile::parse(&std::fs::read(&path).unwrap());
 
     // The structure Mitsuba's `measured` plugin requires (RGB form: `rgb`, no `wavelengths`).
@@ -295,10 +295,10 @@ fn rgl_export_refuses_bad_resolutions_and_writes_nothing() {
     smithwalk::write_outputs(&sim, &config, dir.path()).unwrap();
     let out = dir.path().join("x.bsdf");
     for resolution in [0, 1, 1025] {
-        let err = smithwalk::rgl::export(dir.path(), &out, resolution).unwrap_err().to_string();
+        let err = smithwalk::exports::rgl::export(dir.path(), &out, resolution).unwrap_err().to_string();
         assert!(err.contains(&format!("--resolution {resolution}")) && err.contains("2 to 1024"), "{err}");
         assert!(!out.exists(), "no file on error");
     }
-    smithwalk::rgl::export(dir.path(), &out, 2).unwrap();
+    smithwalk::exports::rgl::export(dir.path(), &out, 2).unwrap();
     assert!(out.exists());
 }

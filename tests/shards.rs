@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 
 use common::tables;
 
-use smithwalk::config::Config;
-use smithwalk::run::Shard;
-use smithwalk::shard::{merge, write_shard};
+use smithwalk::engine::run::Shard;
+use smithwalk::engine::shard::{merge, write_shard};
+use smithwalk::setup::config::Config;
 
 const CONFIG: &str = r#"
 paths = 70_000

@@ -25,15 +25,15 @@
 mod common;
 
 use common::{assert_lobes_agree, dir, two_sided_z};
-use smithwalk::detector::{Detector, Grid, Hemisphere};
+use smithwalk::analysis::stats::sidak;
+use smithwalk::engine::detector::{Detector, Grid, Hemisphere};
+use smithwalk::engine::run::chunk_rng;
 use smithwalk::microsurface::DVec3;
 use smithwalk::microsurface::facet::{Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Lambertian, Side};
 use smithwalk::microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 use smithwalk::microsurface::normals::Normals;
 use smithwalk::microsurface::smith::Smith;
 use smithwalk::microsurface::walk::{EnergyPolicy, Loss, Microsurface, Observer};
-use smithwalk::run::chunk_rng;
-use smithwalk::stats::sidak;
 
 const PHOTONS: u64 = 300_000;
 const GRID: Grid = Grid { cos_bins: 8, phi_bins: 16 };

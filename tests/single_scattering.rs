@@ -13,9 +13,9 @@
 mod common;
 
 use common::{albedo, mono, simulate, weighted_bins};
-use smithwalk::detector::Hemisphere;
-use smithwalk::models::single_scattering_bins;
-use smithwalk::stats::{chi_square, sidak};
+use smithwalk::analysis::models::single_scattering_bins;
+use smithwalk::analysis::stats::{chi_square, sidak};
+use smithwalk::engine::detector::Hemisphere;
 
 struct HistogramCase {
     surface: &'static str,
@@ -194,13 +194,13 @@ fn lambertian_single_scattering_albedo_matches_the_formula_values() {
     // THEORY.md §9.4: E1 of Lambertian facets (rho = 1, isotropic GGX) by the [HD15] formula,
     // 10^6 samples there (SE about 5e-4): 0.7805 (alpha 0.5, 0 deg), 0.7557 (0.5, 60 deg),
     // 0.5817 (1.0, 0 deg), 0.5647 (1.0, 60 deg). Our quadrature over a 4 x 8 grid.
-    let grid = smithwalk::detector::Grid { cos_bins: 4, phi_bins: 8 };
+    let grid = smithwalk::engine::detector::Grid { cos_bins: 4, phi_bins: 8 };
     for (alpha, theta, reference) in [(0.5, 0.0, 0.7805), (0.5, 60.0, 0.7557), (1.0, 0.0, 0.5817), (1.0, 60.0, 0.5647)]
     {
         let toml = format!(
             "paths = 10\n[surface]\nalpha = {alpha}\n[material]\nkind = \"diffuse\"\n[incident]\ntheta_deg = {theta}\n"
         );
-        let case = smithwalk::cases::expand(&smithwalk::config::Config::parse(&toml).unwrap())[0].clone();
+        let case = smithwalk::setup::cases::expand(&smithwalk::setup::config::Config::parse(&toml).unwrap())[0].clone();
         let e1: f64 = single_scattering_bins(&case, &grid, Hemisphere::R, 1e-9).unwrap().iter().sum();
         assert!((e1 - reference).abs() < 2e-3, "alpha {alpha} theta {theta}: E1 = {e1}, formula {reference}");
     }

@@ -21,8 +21,8 @@ use microsurface::DVec3;
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, visible_slope_beckmann};
 use microsurface::normals::Normals;
 use rand_pcg::Pcg64Mcg;
-use smithwalk::quadrature::{integrate, integrate_2d};
-use smithwalk::stats::{WeightedBin, chi_square, sidak};
+use smithwalk::analysis::quadrature::{integrate, integrate_2d};
+use smithwalk::analysis::stats::{WeightedBin, chi_square, sidak};
 
 const SAMPLES: u64 = 200_000;
 const COS_BINS: usize = 16;

@@ -17,11 +17,11 @@ mod common;
 use common::{albedo, mono, simulate_with, weighted_bins};
 use microsurface::wang::Shadowing;
 use smithwalk::Simulation;
-use smithwalk::detector::Hemisphere;
-use smithwalk::models::single_scattering_bins;
-use smithwalk::output::EnergyBalance;
-use smithwalk::run::Estimator;
-use smithwalk::stats::{chi_square, sidak};
+use smithwalk::analysis::models::single_scattering_bins;
+use smithwalk::analysis::stats::{chi_square, sidak};
+use smithwalk::engine::detector::Hemisphere;
+use smithwalk::engine::run::Estimator;
+use smithwalk::io::output::EnergyBalance;
 
 fn conductor(alpha: f64, theta: f64, seed: u64) -> String {
     format!(

@@ -2,11 +2,11 @@
 #![allow(dead_code)]
 
 use smithwalk::Simulation;
-use smithwalk::config::Config;
-use smithwalk::detector::{Detector, Hemisphere, OrderTallies};
+use smithwalk::analysis::stats::WeightedBin;
+use smithwalk::engine::detector::{Detector, Hemisphere, OrderTallies};
+use smithwalk::engine::run::CaseResult;
 use smithwalk::microsurface::DVec3;
-use smithwalk::run::CaseResult;
-use smithwalk::stats::WeightedBin;
+use smithwalk::setup::config::Config;
 
 /// The `smithwalk` binary with `args`, its output discarded.
 pub fn smithwalk_quiet(args: &[&str]) -> std::process::Command {
@@ -27,11 +27,11 @@ pub fn simulate(toml: &str, threads: usize) -> Simulation {
 }
 
 /// Parses a TOML config and runs it with `estimator` (the walk or a model) on 2 threads.
-pub fn simulate_with(toml: &str, estimator: smithwalk::run::Estimator) -> Simulation {
+pub fn simulate_with(toml: &str, estimator: smithwalk::engine::run::Estimator) -> Simulation {
     let config = Config::parse(toml).expect("test config is valid");
     let options = smithwalk::RunOptions {
         estimator,
-        shard: smithwalk::run::Shard::WHOLE,
+        shard: smithwalk::engine::run::Shard::WHOLE,
         threads: Some(2),
         show_progress: false,
     };
@@ -122,7 +122,7 @@ pub fn assert_lobes_agree(
     label: &str,
 ) {
     for &slot in slots {
-        let test = smithwalk::stats::two_sample(
+        let test = smithwalk::analysis::stats::two_sample(
             &weighted_bins(a, slot, hemisphere),
             a.tallies.photons,
             &weighted_bins(b, slot, hemisphere),

@@ -7,12 +7,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail, ensure};
 use serde::{Deserialize, Serialize};
 
-use crate::Simulation;
-use crate::cases::{Case, expand};
-use crate::config::Config;
-use crate::detector::{Detector, Grid, Tallies};
-use crate::output::write_atomically;
-use crate::run::{CaseResult, Shard};
+use crate::atomic::write_atomically;
+use crate::engine::Simulation;
+use crate::engine::detector::{Detector, Grid, Tallies};
+use crate::engine::run::{CaseResult, Shard};
+use crate::setup::cases::{Case, expand};
+use crate::setup::config::Config;
 
 /// The file a shard writes into its output directory.
 pub const SHARD_FILE: &str = "shard.bin";

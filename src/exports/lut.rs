@@ -15,15 +15,16 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::config::{
+use crate::analysis::quadrature::gauss_legendre;
+use crate::atomic::write_atomically;
+use crate::engine::detector::Hemisphere;
+use crate::engine::run::Estimator;
+use crate::engine::{RunOptions, Simulation};
+use crate::io::output::name;
+use crate::setup::config::{
     Alpha, Channels, Config, ConfigError, DetectorConfig, EnergyConfig, IncidentConfig, IncidentSide, MaterialConfig,
     NdfKind, OneOrMany, PrecisionConfig, SurfaceConfig, invalid,
 };
-use crate::detector::Hemisphere;
-use crate::output::{name, write_atomically};
-use crate::quadrature::gauss_legendre;
-use crate::run::Estimator;
-use crate::{RunOptions, Simulation};
 
 /// Which facet material a table is for.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
@@ -192,7 +193,7 @@ impl LutConfig {
     fn materials(&self) -> Vec<MaterialConfig> {
         match self.table {
             TableKind::Conductor => vec![MaterialConfig::Conductor {
-                fresnel: crate::config::FresnelKind::None,
+                fresnel: crate::setup::config::FresnelKind::None,
                 f0: None,
                 eta: None,
                 k: None,
@@ -233,9 +234,9 @@ impl LutConfig {
             surface: SurfaceConfig {
                 ndf: OneOrMany::One(self.ndf),
                 alpha: OneOrMany::Many(self.alpha_nodes().into_iter().map(Alpha::Isotropic).collect()),
-                height: OneOrMany::One(crate::config::HeightKind::Uniform),
-                smith: OneOrMany::One(crate::config::SmithKind::Exact),
-                normals: OneOrMany::One(crate::config::NormalsKind::Vndf),
+                height: OneOrMany::One(crate::setup::config::HeightKind::Uniform),
+                smith: OneOrMany::One(crate::setup::config::SmithKind::Exact),
+                normals: OneOrMany::One(crate::setup::config::NormalsKind::Vndf),
             },
             material: OneOrMany::Many(self.materials()),
             incident: IncidentConfig {
@@ -339,8 +340,9 @@ impl Lut {
 pub fn build(config: &LutConfig, threads: Option<usize>, show_progress: bool) -> Result<Lut> {
     config.validate()?;
     let run = config.run_config();
-    let options = RunOptions { estimator: Estimator::Walk, shard: crate::run::Shard::WHOLE, threads, show_progress };
-    let sim = crate::simulate_from(&run, &options, None, &mut |_, _, _| Ok(()))?;
+    let options =
+        RunOptions { estimator: Estimator::Walk, shard: crate::engine::run::Shard::WHOLE, threads, show_progress };
+    let sim = crate::engine::simulate_from(&run, &options, None, &mut |_, _, _| Ok(()))?;
     Ok(assemble(config, &sim))
 }
 

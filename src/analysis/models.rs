@@ -10,10 +10,10 @@ use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, slope_to_normal};
 use microsurface::single;
 use rayon::prelude::*;
 
-use crate::cases::Case;
-use crate::config::{FresnelKind, IncidentSide, MaterialConfig, NdfKind, NormalsKind, SmithKind};
-use crate::detector::{Grid, Hemisphere};
-use crate::quadrature::{gauss_legendre, integrate_2d};
+use crate::analysis::quadrature::{gauss_legendre, integrate_2d};
+use crate::engine::detector::{Grid, Hemisphere};
+use crate::setup::cases::Case;
+use crate::setup::config::{FresnelKind, IncidentSide, MaterialConfig, NdfKind, NormalsKind, SmithKind};
 
 /// The outgoing direction of a bin coordinate: `|cos theta| = u`, azimuth `phi` from the
 /// incident azimuth `phi_i`, in the hemisphere of `sign`.

@@ -629,8 +629,8 @@ mod tests {
                     }
                 };
                 for _ in 0..100_000 {
-                    let phi = std::f64::consts::TAU * crate::microsurface::random::open01(&mut rng);
-                    let z = 2.0 * crate::microsurface::random::open01(&mut rng) - 1.0;
+                    let phi = std::f64::consts::TAU * microsurface::random::open01(&mut rng);
+                    let z = 2.0 * microsurface::random::open01(&mut rng) - 1.0;
                     let r = (1.0 - z * z).sqrt();
                     check(DVec3::new(r * phi.cos(), r * phi.sin(), z));
                 }
@@ -656,13 +656,13 @@ mod tests {
         let mut pieces = Detector::<1>::new(grid, wi, Some(3));
         let mut settled = Detector::<1>::new(grid, wi, Some(3));
         for n in 0..20_000 {
-            let z = 2.0 * crate::microsurface::random::open01(&mut rng) - 1.0;
-            let phi = std::f64::consts::TAU * crate::microsurface::random::open01(&mut rng);
+            let z = 2.0 * microsurface::random::open01(&mut rng) - 1.0;
+            let phi = std::f64::consts::TAU * microsurface::random::open01(&mut rng);
             let r = (1.0 - z * z).sqrt();
             let dir = DVec3::new(r * phi.cos(), r * phi.sin(), z);
             let side = if z > 0.0 { Side::Outside } else { Side::Inside };
             let order = 1 + (rng.next_u64() % 5) as u32;
-            let weight = if n % 7 == 3 { [0.25 + 0.5 * crate::microsurface::random::open01(&mut rng)] } else { [1.0] };
+            let weight = if n % 7 == 3 { [0.25 + 0.5 * microsurface::random::open01(&mut rng)] } else { [1.0] };
             general.escape(order, side, dir, &weight);
             general.end_photon(u64::from(order));
             whole.escape_photon(order, side, dir, &weight);

@@ -8,9 +8,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use serde::Deserialize;
 
-use crate::cases::Case;
-use crate::config::Config;
-use crate::detector::Grid;
+use crate::engine::detector::Grid;
+use crate::setup::cases::Case;
+use crate::setup::config::Config;
 
 /// A CSV table of a run directory, read whole, with its columns found by name.
 pub(crate) struct Table {
@@ -154,7 +154,7 @@ pub struct RunDir {
 impl RunDir {
     pub fn open(path: &Path) -> Result<Self> {
         let config = read_config(path)?;
-        let cases = crate::cases::expand(&config);
+        let cases = crate::setup::cases::expand(&config);
         let grid = Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins };
         Ok(Self { path: path.to_path_buf(), config, cases, grid })
     }

@@ -9,11 +9,11 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, ensure};
 use serde::{Deserialize, Serialize};
 
-use crate::cases::expand;
-use crate::config::Config;
-use crate::output::write_atomically;
-use crate::run::{CaseState, Shard};
-use crate::shard::CaseTallies;
+use crate::atomic::write_atomically;
+use crate::engine::run::{CaseState, Shard};
+use crate::engine::shard::CaseTallies;
+use crate::setup::cases::expand;
+use crate::setup::config::Config;
 
 /// The file a run keeps its checkpoint in, inside its output directory.
 pub const CHECKPOINT_FILE: &str = "checkpoint.bin";

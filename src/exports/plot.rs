@@ -23,9 +23,10 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 
-use crate::cases::Case;
-use crate::output::{case_fields, write_atomically};
-use crate::rundir::{BinValue, Lobes, RunDir, SummaryRow};
+use crate::atomic::write_atomically;
+use crate::io::output::case_fields;
+use crate::io::rundir::{BinValue, Lobes, RunDir, SummaryRow};
+use crate::setup::cases::Case;
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 /// Points of a curve with error bars: (x, y, standard error).
@@ -378,11 +379,12 @@ pub fn plot(run_dir: &Path) -> Result<Vec<PathBuf>> {
     for (group, cases) in groups(&run.cases).into_iter().enumerate() {
         let _ = writeln!(html, "<h2>{}</h2>", html_escape(&surface_label(cases[0])));
         html.push_str("<table><tr>");
-        for column in crate::output::CASE_COLUMNS {
+        for column in crate::io::output::CASE_COLUMNS {
             let _ = write!(html, "<th>{column}</th>");
         }
         html.push_str("<th>heat maps</th></tr>\n");
-        let hemispheres: Vec<String> = crate::output::hemispheres(cases[0]).iter().map(|h| format!("{h:?}")).collect();
+        let hemispheres: Vec<String> =
+            crate::io::output::hemispheres(cases[0]).iter().map(|h| format!("{h:?}")).collect();
         for case in &cases {
             html.push_str("<tr>");
             for field in case_fields(case) {
@@ -416,12 +418,12 @@ mod tests {
     #[test]
     fn plane_of_incidence_puts_the_mirror_side_at_positive_angles() {
         let dir = tempfile::tempdir().unwrap();
-        let config = crate::config::Config::parse(
+        let config = crate::setup::config::Config::parse(
             "paths = 10\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 30\n[detector]\ncos_theta_bins = 4\nphi_bins = 8\n",
         )
         .unwrap();
-        let sim = crate::simulate(&config, Some(1), false).unwrap();
-        crate::write_outputs(&sim, &config, dir.path()).unwrap();
+        let sim = crate::engine::simulate(&config, Some(1), false).unwrap();
+        crate::io::output::write_outputs(&sim, &config, dir.path()).unwrap();
         let run = RunDir::open(dir.path()).unwrap();
         // Energy 0.1 only in cos bin 2 (|cos| in [0.5, 0.75)), phi bin 4 (phi in [180, 225) deg).
         let mut bins = vec![BinValue::default(); 32];

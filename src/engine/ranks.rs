@@ -9,7 +9,7 @@ use mpi::environment::Universe;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives, Destination, Source};
 
-use crate::run::Shard;
+use crate::engine::run::Shard;
 
 /// The rank that gathers the accumulators and writes the outputs.
 const ROOT: i32 = 0;

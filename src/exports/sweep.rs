@@ -1,15 +1,15 @@
 //! An isotropic reflective sweep: the all-orders reflection lobes of one surface and material
 //! lit from outside at many incident angles, read from a run directory and interpolated to any
-//! pair of directions. The measured-BRDF exports ([`crate::merl`], [`crate::rgl`]) sample it.
+//! pair of directions. The measured-BRDF exports ([`crate::exports::merl`], [`crate::exports::rgl`]) sample it.
 
 use std::f64::consts::TAU;
 
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
-use crate::config::{IncidentSide, NdfKind};
-use crate::detector::Grid;
-use crate::rundir::{BinValue, RunDir};
+use crate::engine::detector::Grid;
+use crate::io::rundir::{BinValue, RunDir};
+use crate::setup::config::{IncidentSide, NdfKind};
 
 /// The all-orders reflection lobes of an isotropic sweep over the incident angle.
 pub struct Sweep {

@@ -1,17 +1,17 @@
 //! Output files of a run: `lobes.csv`, `summary.csv` and `run.json`, each written atomically
 //! (temporary file in the output directory, then rename), and only after every case finished.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde::Serialize;
 
-use crate::Simulation;
-use crate::cases::Case;
-use crate::config::{Config, IncidentSide};
-use crate::detector::{Detector, Hemisphere, Tally};
-use crate::run::CaseResult;
+use crate::atomic::write_atomically;
+use crate::engine::Simulation;
+use crate::engine::detector::{Detector, Hemisphere, Tally};
+use crate::engine::run::CaseResult;
+use crate::setup::cases::Case;
+use crate::setup::config::{Config, IncidentSide};
 
 const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
 
@@ -260,7 +260,7 @@ pub fn run_json(sim: &Simulation, config: &Config) -> Result<Vec<u8>> {
         seed: config.seed,
         paths: config.paths,
         threads: sim.threads,
-        chunk_photons: crate::run::CHUNK,
+        chunk_photons: crate::engine::run::CHUNK,
         wall_seconds: sim.wall_seconds,
         paths_per_second: total / sim.wall_seconds.max(1e-9),
         cases: sim
@@ -275,55 +275,9 @@ pub fn run_json(sim: &Simulation, config: &Config) -> Result<Vec<u8>> {
     Ok(text)
 }
 
-/// Output files are ordinary readable files (temporary files start private).
-#[cfg(unix)]
-fn make_readable(file: &std::fs::File) -> std::io::Result<()> {
-    use std::os::unix::fs::PermissionsExt;
-    file.set_permissions(std::fs::Permissions::from_mode(0o644))
-}
-
-#[cfg(not(unix))]
-fn make_readable(_file: &std::fs::File) -> std::io::Result<()> {
-    Ok(())
-}
-
-/// Makes sure `dir` exists and is writable, before any simulation time is spent.
-pub fn prepare_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("--out {}: cannot create the output directory", dir.display()))?;
-    tempfile::NamedTempFile::new_in(dir)
-        .with_context(|| format!("--out {}: the output directory is not writable", dir.display()))?;
-    Ok(())
-}
-
-/// Writes one file at the path `out` (whose directory is created if need be) atomically.
-pub fn write_file_atomically(out: &Path, bytes: Vec<u8>) -> Result<PathBuf> {
-    let dir = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let name = out.file_name().and_then(|n| n.to_str()).context("--out needs a file name")?;
-    prepare_dir(dir)?;
-    let written = write_atomically(dir, &[(name, bytes)])?;
-    Ok(written.into_iter().next().expect("one file"))
-}
-
-/// Writes all files: every one goes to a temporary file first; only when all are complete are
-/// they renamed into place, so a failure leaves no partial or corrupt output.
-pub fn write_atomically(dir: &Path, files: &[(&str, Vec<u8>)]) -> Result<Vec<PathBuf>> {
-    let mut staged = Vec::new();
-    for (file, bytes) in files {
-        let mut tmp = tempfile::NamedTempFile::new_in(dir)
-            .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
-        tmp.write_all(bytes).with_context(|| format!("cannot write {file}"))?;
-        make_readable(tmp.as_file()).with_context(|| format!("cannot set the permissions of {file}"))?;
-        tmp.as_file().sync_all().with_context(|| format!("cannot write {file}"))?;
-        staged.push((tmp, dir.join(file)));
-    }
-    let mut written = Vec::new();
-    for (tmp, path) in staged {
-        tmp.persist(&path).with_context(|| format!("cannot rename into {}", path.display()))?;
-        written.push(path);
-    }
-    Ok(written)
+/// Writes `lobes.csv`, `summary.csv` and `run.json` of a simulation into `dir`, atomically.
+pub fn write_outputs(sim: &Simulation, config: &Config, dir: &Path) -> Result<Vec<PathBuf>> {
+    let files =
+        [("lobes.csv", lobes_csv(sim)?), ("summary.csv", summary_csv(sim)?), ("run.json", run_json(sim, config)?)];
+    write_atomically(dir, &files)
 }

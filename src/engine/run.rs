@@ -20,9 +20,9 @@ use microsurface::wang::Shadowing;
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
 
-use crate::cases::Case;
-use crate::config::{Config, FresnelKind, MaterialConfig, NdfKind, NormalsKind, SmithKind};
-use crate::detector::{Detector, Grid, Hemisphere};
+use crate::engine::detector::{Detector, Grid, Hemisphere};
+use crate::setup::cases::Case;
+use crate::setup::config::{Config, FresnelKind, MaterialConfig, NdfKind, NormalsKind, PrecisionConfig, SmithKind};
 
 /// Photons per chunk: the unit of work and of random streams. Part of the output's identity:
 /// changing it changes which random numbers each photon uses.
@@ -170,6 +170,14 @@ impl CaseResult {
             CaseResult::Mono(d) => of(d, slot, hemisphere),
             CaseResult::Rgb(d) => of(d, slot, hemisphere),
         }
+    }
+
+    /// Whether this measurement meets a precision target: every nonzero albedo of the target's
+    /// order slots has at most the target's absolute and relative standard errors.
+    pub fn meets(&self, target: &PrecisionConfig) -> bool {
+        self.albedo_stderrs(target.orders).iter().all(|&(mean, se)| {
+            target.target_stderr.is_none_or(|t| se <= t) && target.target_rel_stderr.is_none_or(|t| se <= t * mean)
+        })
     }
 
     /// The albedos and standard errors of order slots `0..=slots` in both hemispheres
@@ -347,7 +355,7 @@ where
     }
 }
 
-fn channels_of<const C: usize>(c: &Option<crate::config::Channels>) -> [f64; C] {
+fn channels_of<const C: usize>(c: &Option<crate::setup::config::Channels>) -> [f64; C] {
     c.expect("validated: the Fresnel mode's parameters are present").to_array()
 }
 

@@ -38,10 +38,10 @@ use anyhow::{Result, bail};
 use glam::DVec3;
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 
-use crate::config::NdfKind;
-use crate::output::write_file_atomically;
-use crate::rundir::RunDir;
-use crate::sweep::Sweep;
+use crate::atomic::write_file_atomically;
+use crate::exports::sweep::Sweep;
+use crate::io::rundir::RunDir;
+use crate::setup::config::NdfKind;
 
 /// The grid points per axis of the u square unless `--resolution` says otherwise.
 pub const DEFAULT_RESOLUTION: usize = 64;

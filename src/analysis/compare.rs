@@ -16,54 +16,15 @@ use std::path::Path;
 use anyhow::Result;
 use microsurface::wang::Shadowing;
 
-use crate::config::Config;
-use crate::detector::{Grid, Hemisphere};
-use crate::models::{HammonFitPart, hammon_fit_bins, single_scattering_bins};
-use crate::output::{case_fields, write_atomically};
-use crate::run::{Estimator, Shard};
-use crate::rundir::{Table, read_config};
-use crate::stats::{self, ChiSquare, WeightedBin};
-use crate::{RunOptions, Simulation};
-
-/// The analytic models `compare` knows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Model {
-    Single,
-    HammonFit,
-    HeitzNee,
-    WangCorrelated,
-    WangUncorrelated,
-    ExactPositionFree,
-}
-
-impl Model {
-    pub const ALL: [Model; 6] = [
-        Model::Single,
-        Model::HammonFit,
-        Model::HeitzNee,
-        Model::WangCorrelated,
-        Model::WangUncorrelated,
-        Model::ExactPositionFree,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Model::Single => "single",
-            Model::HammonFit => "hammon-fit",
-            Model::HeitzNee => "heitz-nee",
-            Model::WangCorrelated => "wang-correlated",
-            Model::WangUncorrelated => "wang-uncorrelated",
-            Model::ExactPositionFree => "exact-position-free",
-        }
-    }
-
-    pub fn parse(text: &str) -> Result<Self, String> {
-        Model::ALL.into_iter().find(|m| m.name() == text).ok_or_else(|| {
-            let names: Vec<&str> = Model::ALL.iter().map(|m| m.name()).collect();
-            format!("{text:?} is not a model; allowed: {}", names.join(", "))
-        })
-    }
-}
+use crate::analysis::models::{HammonFitPart, hammon_fit_bins, single_scattering_bins};
+use crate::analysis::stats::{self, ChiSquare, WeightedBin};
+use crate::atomic::write_atomically;
+use crate::engine::detector::{Grid, Hemisphere};
+use crate::engine::run::{Estimator, Shard};
+use crate::engine::{RunOptions, Simulation};
+use crate::io::output::case_fields;
+use crate::io::rundir::{Table, read_config};
+use crate::setup::config::{Config, Model};
 
 /// Outgoing directions per hit of the next-event estimator.
 const NEE_DIRECTIONS: u32 = 4;
@@ -136,15 +97,15 @@ fn predict(
     threads: Option<usize>,
 ) -> Result<Vec<Prediction>> {
     let grid = Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins };
-    let cases = crate::cases::expand(config);
+    let cases = crate::setup::cases::expand(config);
     let mut out = Vec::new();
-    let rows = |case: &crate::cases::Case,
+    let rows = |case: &crate::setup::cases::Case,
                 order: usize,
                 hemisphere: Hemisphere,
                 channel: &str,
                 values: &mut dyn FnMut(usize) -> Value,
                 out: &mut Vec<Prediction>| {
-        let sign = crate::output::hemisphere_sign(case.side, hemisphere);
+        let sign = crate::io::output::hemisphere_sign(case.side, hemisphere);
         for ic in 0..grid.cos_bins {
             let (lo, hi) = grid.cos_edges(ic);
             let (cos_lo, cos_hi) = if sign > 0.0 { (lo, hi) } else { (-hi, -lo) };
@@ -175,7 +136,7 @@ fn predict(
     match model {
         Model::Single => {
             for case in &cases {
-                for &h in crate::output::hemispheres(case) {
+                for &h in crate::io::output::hemispheres(case) {
                     let Some(bins) = single_scattering_bins(case, &grid, h, tol) else { continue };
                     rows(case, 1, h, channel, &mut |i| Value { energy: bins[i], stderr: 0.0 }, &mut out);
                 }
@@ -198,7 +159,7 @@ fn predict(
             };
             let model_config = Config { seed, ..config.clone() };
             let options = RunOptions { estimator, shard: Shard::WHOLE, threads, show_progress: true };
-            let sim = crate::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))?;
+            let sim = crate::engine::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))?;
             for_each_lobe(&sim, &mut |case, order, hemisphere, channel, value| {
                 if model != Model::ExactPositionFree || case.position_free_applies() {
                     rows(case, order, hemisphere, channel, value, &mut out)
@@ -209,16 +170,21 @@ fn predict(
     Ok(out)
 }
 
-type LobeVisitor<'a> = dyn FnMut(&crate::cases::Case, usize, Hemisphere, &str, &mut dyn FnMut(usize) -> Value) + 'a;
+type LobeVisitor<'a> =
+    dyn FnMut(&crate::setup::cases::Case, usize, Hemisphere, &str, &mut dyn FnMut(usize) -> Value) + 'a;
 
 /// Calls `f` for every lobe (case, order, hemisphere, channel) of a simulation with a function
 /// giving each bin's value.
 fn for_each_lobe(sim: &Simulation, f: &mut LobeVisitor<'_>) {
-    fn visit<const C: usize>(case: &crate::cases::Case, d: &crate::detector::Detector<C>, f: &mut LobeVisitor<'_>) {
+    fn visit<const C: usize>(
+        case: &crate::setup::cases::Case,
+        d: &crate::engine::detector::Detector<C>,
+        f: &mut LobeVisitor<'_>,
+    ) {
         let bins = d.grid.bins();
         let n = d.tallies.photons;
         for (slot, tallies) in d.tallies.orders.iter().enumerate() {
-            for &h in crate::output::hemispheres(case) {
+            for &h in crate::io::output::hemispheres(case) {
                 for c in 0..C {
                     let channel = if C > 1 { ["r", "g", "b"][c] } else { "" };
                     let mut value = |i: usize| {
@@ -232,8 +198,8 @@ fn for_each_lobe(sim: &Simulation, f: &mut LobeVisitor<'_>) {
     }
     for (case, result) in sim.cases.iter().zip(&sim.results) {
         match result {
-            crate::run::CaseResult::Mono(d) => visit(case, d, f),
-            crate::run::CaseResult::Rgb(d) => visit(case, d, f),
+            crate::engine::run::CaseResult::Mono(d) => visit(case, d, f),
+            crate::engine::run::CaseResult::Rgb(d) => visit(case, d, f),
         }
     }
 }
@@ -308,7 +274,7 @@ pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Op
     config.compare = None;
     let rgb = config.is_rgb();
     let mut model_rows = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<&str> = crate::output::CASE_COLUMNS.to_vec();
+    let mut header: Vec<&str> = crate::io::output::CASE_COLUMNS.to_vec();
     header.extend(["model", "order", "hemisphere"]);
     if rgb {
         header.push("channel");
@@ -352,7 +318,7 @@ pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Op
         }
     }
     let mut compare_rows = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<&str> = crate::output::CASE_COLUMNS.to_vec();
+    let mut header: Vec<&str> = crate::io::output::CASE_COLUMNS.to_vec();
     header.extend(["model", "order", "hemisphere"]);
     if rgb {
         header.push("channel");

@@ -4,7 +4,7 @@ use glam::DVec3;
 use itertools::iproduct;
 use serde::Serialize;
 
-use crate::config::{Config, HeightKind, IncidentSide, MaterialConfig, NdfKind, NormalsKind, SmithKind};
+use crate::setup::config::{Config, HeightKind, IncidentSide, MaterialConfig, NdfKind, NormalsKind, SmithKind};
 
 /// One measurement: a surface, a facet material and an incident direction.
 #[derive(Clone, Debug, Serialize, PartialEq)]

@@ -8,8 +8,8 @@ use std::time::{Duration, Instant};
 use anyhow::Result;
 use rustix::time::{ClockId, clock_gettime};
 
-use crate::config::Config;
-use crate::simulate;
+use crate::engine::simulate;
+use crate::setup::config::Config;
 
 /// The reference cases: (label, `[surface]` and `[material]` TOML, theta_i in degrees).
 pub const CASES: [(&str, &str, f64); 5] = [

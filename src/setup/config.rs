@@ -1,6 +1,6 @@
 //! The TOML run configuration: parsing, defaults and validation.
 //!
-//! Every list-valued field is a sweep; [`crate::cases`] expands the configuration into the
+//! Every list-valued field is a sweep; [`crate::setup::cases`] expands the configuration into the
 //! cartesian product of cases. Validation names the field, the value and what is allowed.
 
 use std::fmt;
@@ -369,6 +369,47 @@ pub struct Config {
     pub compare: Option<CompareConfig>,
 }
 
+/// The analytic models `smithwalk compare` can judge a run against (`crate::analysis::compare`
+/// evaluates them; the configuration only names them).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Model {
+    Single,
+    HammonFit,
+    HeitzNee,
+    WangCorrelated,
+    WangUncorrelated,
+    ExactPositionFree,
+}
+
+impl Model {
+    pub const ALL: [Model; 6] = [
+        Model::Single,
+        Model::HammonFit,
+        Model::HeitzNee,
+        Model::WangCorrelated,
+        Model::WangUncorrelated,
+        Model::ExactPositionFree,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Model::Single => "single",
+            Model::HammonFit => "hammon-fit",
+            Model::HeitzNee => "heitz-nee",
+            Model::WangCorrelated => "wang-correlated",
+            Model::WangUncorrelated => "wang-uncorrelated",
+            Model::ExactPositionFree => "exact-position-free",
+        }
+    }
+
+    pub fn parse(text: &str) -> Result<Self, String> {
+        Model::ALL.into_iter().find(|m| m.name() == text).ok_or_else(|| {
+            let names: Vec<&str> = Model::ALL.iter().map(|m| m.name()).collect();
+            format!("{text:?} is not a model; allowed: {}", names.join(", "))
+        })
+    }
+}
+
 /// Models to compare the run with when it finishes (`smithwalk compare` on its output).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -401,13 +442,6 @@ fn default_precision_orders() -> usize {
 }
 
 impl PrecisionConfig {
-    /// Whether a case's measurement meets the target.
-    pub fn is_met(&self, result: &crate::run::CaseResult) -> bool {
-        result.albedo_stderrs(self.orders).iter().all(|&(mean, se)| {
-            self.target_stderr.is_none_or(|t| se <= t) && self.target_rel_stderr.is_none_or(|t| se <= t * mean)
-        })
-    }
-
     fn validate(&self) -> Result<(), ConfigError> {
         if self.target_rel_stderr.is_none() && self.target_stderr.is_none() {
             return Err(invalid("precision", "{}", "a `target_rel_stderr` or a `target_stderr` (or both)"));
@@ -544,8 +578,7 @@ impl Config {
         }
         if let Some(c) = &self.compare {
             for m in &c.models {
-                crate::compare::Model::parse(m)
-                    .map_err(|allowed| invalid("compare.models", format!("{m:?}"), allowed))?;
+                Model::parse(m).map_err(|allowed| invalid("compare.models", format!("{m:?}"), allowed))?;
             }
             if c.paths.is_some_and(|p| p < 2) {
                 return Err(invalid("compare.paths", c.paths.unwrap_or(0), "at least 2 photons per case"));

@@ -18,9 +18,9 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use glam::DVec3;
 
-use crate::output::write_file_atomically;
-use crate::rundir::RunDir;
-use crate::sweep::Sweep;
+use crate::atomic::write_file_atomically;
+use crate::exports::sweep::Sweep;
+use crate::io::rundir::RunDir;
 
 pub const THETA_H_CELLS: usize = 90;
 pub const THETA_D_CELLS: usize = 90;
