@@ -1,7 +1,7 @@
 //! `smithwalk compare` end to end: a run with a `[compare]` section writes models.csv and
 //! compare.csv; the exact single-scattering model is accepted for every order-1 lobe (Sidak
 //! family level 0.01 over the lobes), and the Wang correlated model is rejected for order 2 at
-//! alpha 1, normal incidence, where THEORY.md §6.6 puts a 27 % excess.
+//! alpha 1, normal incidence, where docs/theory.md §6.6 puts a 27 % excess.
 
 use std::process::Command;
 

@@ -1,4 +1,4 @@
-//! Energy conservation and per-order reference values (THEORY.md §9.2, §9.4).
+//! Energy conservation and per-order reference values (docs/theory.md §9.2, §9.4).
 //!
 //! * White furnace: conductor F = 1, Lambertian albedo 1 and dielectric R + T, GGX and
 //!   Beckmann, alpha in {0.1, 0.5, 1, 2}, isotropic and anisotropic, theta_i in {0, 60, 89} deg,

@@ -3,7 +3,7 @@
 //!
 //! * Smooth limit: with alpha -> 0, F0 = 0 and albedo 1, the fit's diffuse term at normal
 //!   incidence integrates to exactly 1 (the 1.05 = 21/20 normalization of the Fresnel-weighted
-//!   exit, THEORY.md §4.5); quadrature over the detector's bins must reproduce that.
+//!   exit, docs/theory.md §4.5); quadrature over the detector's bins must reproduce that.
 //! * Beside the simulation (alpha 0.5, F0 0.02, albedo 0.75, 10^6 photons): the fit is an
 //!   approximation fitted to a different walk (symmetric Lambda, rejection normals), so the test
 //!   records the measured all-order albedo difference and only asserts it stays below 10 %.

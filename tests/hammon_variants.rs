@@ -1,5 +1,5 @@
 //! Hammon 2017's two departures from the Smith walk, measured against the independent Monte
-//! Carlo values of THEORY.md §2.7 and §3.3 (10^6 samples there, SE <= 5e-4): conductor F = 1,
+//! Carlo values of docs/theory.md §2.7 and §3.3 (10^6 samples there, SE <= 5e-4): conductor F = 1,
 //! isotropic GGX. Our runs use 10^6 photons; tolerance 4 combined standard errors.
 //!
 //! * `smith = "symmetric"` (§2.7): single scattering vanishes at normal incidence, and rays

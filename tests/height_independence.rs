@@ -1,4 +1,4 @@
-//! The walk does not depend on the height distribution (THEORY.md §2.1): every quantity
+//! The walk does not depend on the height distribution (docs/theory.md §2.1): every quantity
 //! depends on heights only through `u = C1(h)`, and smithwalk walks in optical depth
 //! `-ln u` (§2.4), so uniform and Gaussian heights must give identical measurements, not
 //! merely statistically compatible ones. Same seed, same photons: every energy, standard

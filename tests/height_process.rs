@@ -1,4 +1,4 @@
-//! The height process of the walk (THEORY.md §2.2–§2.4) against its closed forms.
+//! The height process of the walk (docs/theory.md §2.2–§2.4) against its closed forms.
 //!
 //! From a height with `u = C1(h)`, a ray travelling along `d` escapes (upward only) with
 //! probability `G1(d, h) = u^Lambda(d)` (§2.2); otherwise it stops at `u'` with

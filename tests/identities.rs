@@ -1,6 +1,6 @@
-//! Exact identities of the microsurface quantities (THEORY.md §1, §4, §9.1), each against an
+//! Exact identities of the microsurface quantities (docs/theory.md §1, §4, §9.1), each against an
 //! independent computation: numerical quadrature of the defining integral, a closed form, or
-//! a value quoted in THEORY.md.
+//! a value quoted in docs/theory.md.
 
 mod common;
 

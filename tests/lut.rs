@@ -1,9 +1,9 @@
 //! Energy-compensation tables (`smithwalk lut`) against exact values:
 //! - conductor F = 1: all orders together are exactly 1 in every cell and on average (white
-//!   furnace, THEORY.md §9.2), and the order slots add up to it;
+//!   furnace, docs/theory.md §9.2), and the order slots add up to it;
 //! - order 1 of conductor, dielectric (R and T from outside) and Hammon tables against the
 //!   single-scattering albedo integrated by adaptive quadrature (`models::single_scattering_bins`
-//!   on a 1 x 1 grid, THEORY.md §5), cell by cell: z = (table - quadrature) / SE, two-sided, Sidak
+//!   on a 1 x 1 grid, docs/theory.md §5), cell by cell: z = (table - quadrature) / SE, two-sided, Sidak
 //!   family level 0.01 over the cells of each test; E_avg of order 1 against an adaptive
 //!   Gauss–Kronrod integral over mu of the same quadrature albedo;
 //! - dielectric: R + T of all orders is 1 from both sides (energy is conserved);

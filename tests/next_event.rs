@@ -1,4 +1,4 @@
-//! Next-event estimation (Heitz et al. 2016 `eval`, THEORY.md §4.7) against the escape
+//! Next-event estimation (Heitz et al. 2016 `eval`, docs/theory.md §4.7) against the escape
 //! histogram: two independent estimators of the same bin integrals, order by order. This is
 //! the exact oracle for orders >= 2.
 //!

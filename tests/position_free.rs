@@ -1,10 +1,10 @@
-//! The exact position-free form (THEORY.md §7.1): the walk with its collision depths
+//! The exact position-free form (docs/theory.md §7.1): the walk with its collision depths
 //! integrated out, run on the height-free chain.
 //!
 //! * The depth profile against closed forms of §6.3 and §7.1 (one and two bounces, the
 //!   down-up-down-up pattern of §7.3, equal rates), and against a direct simulation of the
 //!   depth process for a longer pattern (10^6 samples, within 4 SE).
-//! * Per-order albedos, conductor F = 1, isotropic GGX, against THEORY.md §9.4's table (walk,
+//! * Per-order albedos, conductor F = 1, isotropic GGX, against docs/theory.md §9.4's table (walk,
 //!   2*10^6 photons, SE <= 4e-4, rounded to 4 decimals), 10^6 chains here, within 4 combined
 //!   standard errors.
 //! * Lobes of orders 1, 2, 3, 4 and all against the walk's histograms for conductor (F = 1 and

@@ -1,4 +1,4 @@
-//! Reciprocity of the walk (THEORY.md §2.6, §9.3), by next-event point estimates of the
+//! Reciprocity of the walk (docs/theory.md §2.6, §9.3), by next-event point estimates of the
 //! per-order lobe at fixed direction pairs: `f_k(wi, wo) = f_k(wo, wi)` for mirror, Lambertian
 //! and Hammon facets (orders 1 to 4), and the power-form transmission identity
 //! `f_t(wi, wo) / eta_o^2 = f_t(wo, wi) / eta_i^2` for the dielectric. Each estimate uses

@@ -1,6 +1,6 @@
 //! Photons walked side by side (`Microsurface::walk_side_by_side`, the measurement's walk for
 //! paths that never split) against the plain walk (`Microsurface::trace`): the same random
-//! walk (THEORY.md §4) with the random numbers drawn in another order, so the two must
+//! walk (docs/theory.md §4) with the random numbers drawn in another order, so the two must
 //! measure the same lobes.
 //!
 //! Seven cases cover every part of a lane's step: GGX and anisotropic Beckmann conductors
@@ -172,7 +172,7 @@ fn every_photon_walked_side_by_side_ends_once_with_its_weight_and_interactions()
                 Smith::Exact => {
                     assert_eq!((ledger.escaped, ledger.lost), (n, 0.0));
                     // At normal incidence on alpha = 1 a photon makes 2.3 interactions on
-                    // average (THEORY.md §9.4 orders): a broken count would be far off.
+                    // average (docs/theory.md §9.4 orders): a broken count would be far off.
                     if photons >= 1000 {
                         let mean = ledger.interactions as f64 / n;
                         assert!((2.2..2.4).contains(&mean), "{mean} interactions per photon");

@@ -1,4 +1,4 @@
-//! Order 1 of the walk against exact single scattering (THEORY.md §5): this is the test that
+//! Order 1 of the walk against exact single scattering (docs/theory.md §5): this is the test that
 //! proves the walk.
 //!
 //! * Histograms: for each case below, 10^6 photons on a 16 x 32 grid; the expected energy of
@@ -7,7 +7,7 @@
 //!   moments (weighted histograms); cells with an expected count below 5 are pooled. Each
 //!   chi-square test runs at the Sidak level keeping the family (all 8 tests) at 0.01.
 //! * Albedo: at 10^7 photons the order-1 albedo of the GGX conductor with F = 1 is compared
-//!   with the quadrature values of THEORY.md §9.4 (independent scripts; 1 - ln 2 in closed
+//!   with the quadrature values of docs/theory.md §9.4 (independent scripts; 1 - ln 2 in closed
 //!   form at alpha 1, normal incidence), within 4 standard errors (SE about 1.5e-4).
 
 mod common;
@@ -102,7 +102,7 @@ fn order_one_histograms_match_single_scattering() {
 
 #[test]
 fn order_one_albedo_matches_quadrature() {
-    // (alpha, theta_i, E1 from THEORY.md §9.4 quadrature)
+    // (alpha, theta_i, E1 from docs/theory.md §9.4 quadrature)
     let refs = [(1.0, 0.0, 1.0 - std::f64::consts::LN_2), (1.0, 60.0, 0.450694), (0.5, 0.0, 0.687849)];
     for (i, (alpha, theta, e1)) in refs.into_iter().enumerate() {
         let toml = format!(
@@ -191,7 +191,7 @@ fn order_one_of_scattering_facets_matches_single_scattering() {
 
 #[test]
 fn lambertian_single_scattering_albedo_matches_the_formula_values() {
-    // THEORY.md §9.4: E1 of Lambertian facets (rho = 1, isotropic GGX) by the [HD15] formula,
+    // docs/theory.md §9.4: E1 of Lambertian facets (rho = 1, isotropic GGX) by the [HD15] formula,
     // 10^6 samples there (SE about 5e-4): 0.7805 (alpha 0.5, 0 deg), 0.7557 (0.5, 60 deg),
     // 0.5817 (1.0, 0 deg), 0.5647 (1.0, 60 deg). Our quadrature over a 4 x 8 grid.
     let grid = smithwalk::engine::detector::Grid { cos_bins: 4, phi_bins: 8 };

@@ -1,4 +1,4 @@
-//! Closed-form GGX slope-space polygon masses (THEORY.md §8.1, Loubet et al. 2020) and their
+//! Closed-form GGX slope-space polygon masses (docs/theory.md §8.1, Loubet et al. 2020) and their
 //! generalization to the visible normals of any direction (§8.2) against numerical
 //! quadrature, and then used as exact expected counts of histograms of sampled slopes over a
 //! triangulated slope-space grid (chi-square; cells with expected count < 5 pooled; 500 000

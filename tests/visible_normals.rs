@@ -1,5 +1,5 @@
 //! Visible-normal sampling against the visible-normal density integrated over bins
-//! (THEORY.md §3.1, §3.2, §3.3).
+//! (docs/theory.md §3.1, §3.2, §3.3).
 //!
 //! For each NDF, roughness and direction (above and below the horizon) 200 000 normals are
 //! drawn and binned on a 16 x 16 grid uniform in cos(theta_m) x phi_m. The expected bin

@@ -1,8 +1,8 @@
-//! The Wang et al. 2022 models as height-free chains (THEORY.md §6.5) against independent
+//! The Wang et al. 2022 models as height-free chains (docs/theory.md §6.5) against independent
 //! numbers and against the random walk.
 //!
 //! * Per-order albedos of both variants (conductor F = 1, isotropic GGX) against the
-//!   independent VNDF-chain values of THEORY.md §6.6 (10^6 chains, SE about 5e-4), 10^6
+//!   independent VNDF-chain values of docs/theory.md §6.6 (10^6 chains, SE about 5e-4), 10^6
 //!   photons here, within 4 combined standard errors (ours, the table's binomial SE and its
 //!   4-decimal rounding).
 //! * Order 1 of the correlated model is exact single scattering (§6.3): chi-square of its
@@ -34,7 +34,7 @@ const UNCORRELATED: Estimator = Estimator::Wang(Shadowing::Uncorrelated);
 
 #[test]
 fn per_order_albedos_match_the_independent_chains() {
-    // (alpha, theta, correlated E1..E5, uncorrelated E1..E5) from THEORY.md §6.6.
+    // (alpha, theta, correlated E1..E5, uncorrelated E1..E5) from docs/theory.md §6.6.
     let table: [(f64, f64, [f64; 5], [f64; 5]); 6] = [
         (0.5, 0.0, [0.6882, 0.2469, 0.0533, 0.0093, 0.0018], [0.6882, 0.2443, 0.0571, 0.0092, 0.0011]),
         (0.5, 60.0, [0.6985, 0.2511, 0.0420, 0.0066, 0.0014], [0.6863, 0.2564, 0.0502, 0.0065, 0.0006]),

@@ -81,7 +81,7 @@ pub fn dir(theta_deg: f64, phi_deg: f64) -> DVec3 {
     DVec3::new(st * cp, st * sp, ct)
 }
 
-/// THEORY.md §9.4: per-order albedos E1..E6 of the random walk, conductor F = 1, isotropic
+/// docs/theory.md §9.4: per-order albedos E1..E6 of the random walk, conductor F = 1, isotropic
 /// GGX, (alpha, theta_i deg); 2*10^6 photons, SE <= 4e-4, rounded to 4 decimals.
 pub const CONDUCTOR_ORDERS: [(f64, f64, [f64; 6]); 8] = [
     (0.5, 0.0, [0.6883, 0.2316, 0.0642, 0.0135, 0.0021, 0.0003]),

@@ -1,4 +1,4 @@
-//! Height-free chains of visible-normal scatterings (THEORY.md §6.5, §7.1): the position-free
+//! Height-free chains of visible-normal scatterings (docs/theory.md §6.5, §7.1): the position-free
 //! models of the walk's lobes.
 //!
 //! A chain follows one path of directions `d_0, d_1, ...` drawn exactly as the walk draws them

@@ -1,4 +1,4 @@
-//! Micro-BSDFs: what happens when a ray meets a single facet (THEORY.md §4.2–§4.5).
+//! Micro-BSDFs: what happens when a ray meets a single facet (docs/theory.md §4.2–§4.5).
 //!
 //! A facet interaction returns one or two weighted branches. The walk decides how to follow
 //! two branches (split both, or choose one; §4.6); weights below one are absorption. A path

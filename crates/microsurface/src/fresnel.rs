@@ -1,4 +1,4 @@
-//! Fresnel reflectances (THEORY.md §4.2, §4.3, §4.5). `c` is the cosine between the
+//! Fresnel reflectances (docs/theory.md §4.2, §4.3, §4.5). `c` is the cosine between the
 //! direction towards the light and the facet normal, in [0, 1].
 
 /// Schlick's approximation `F0 + (1 - F0) (1 - c)^5`.

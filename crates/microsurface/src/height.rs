@@ -1,4 +1,4 @@
-//! The height process of the walk in optical depth (THEORY.md §2.1–§2.4).
+//! The height process of the walk in optical depth (docs/theory.md §2.1–§2.4).
 //!
 //! The walk depends on a height `h` only through `u = C1(h)` (§2.1), so it runs in optical
 //! depth `tau = -ln u` (§2.4): a semi-infinite homogeneous slab in which free paths are

@@ -1,7 +1,7 @@
 //! The statistical Smith microsurface as a random medium.
 //!
 //! A microsurface is composed of independent pieces, each behind a trait where real
-//! alternatives exist (THEORY.md §0–§4):
+//! alternatives exist (docs/theory.md §0–§4):
 //!
 //! * [`ndf`]: the distribution of normals (GGX, Beckmann), its Smith `Lambda`, projected area
 //!   and exact full-sphere visible-normal sampling;

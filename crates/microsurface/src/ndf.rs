@@ -1,5 +1,5 @@
 //! Normal distribution functions: D, Smith Lambda, projected area and visible-normal sampling
-//! (THEORY.md §1 and §3).
+//! (docs/theory.md §1 and §3).
 //!
 //! Both NDFs are anisotropic with roughness (alpha_x, alpha_y) and stretch-invariant (§1.1):
 //! every quantity is computed in the stretched configuration of roughness 1 where that is

@@ -1,4 +1,4 @@
-//! Next-event estimation of the walk's lobes (Heitz et al. 2016 `eval`, THEORY.md §4.7).
+//! Next-event estimation of the walk's lobes (Heitz et al. 2016 `eval`, docs/theory.md §4.7).
 //!
 //! At the `k`-th hit of a ray (depth `tau`, incident `w = -d`, weight `beta`) the lobe of
 //! order `k` towards `wo` gets `beta p(w -> wo) G1(wo, tau)`: the facet's phase function

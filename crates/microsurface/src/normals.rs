@@ -1,4 +1,4 @@
-//! How the facet hit by a ray is drawn (THEORY.md §3.1, §3.3).
+//! How the facet hit by a ray is drawn (docs/theory.md §3.1, §3.3).
 
 use std::f64::consts::PI;
 

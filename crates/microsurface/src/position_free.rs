@@ -1,4 +1,4 @@
-//! The exact position-free form of the walk (THEORY.md §7.1; Bitterli and d'Eon 2022): the
+//! The exact position-free form of the walk (docs/theory.md §7.1; Bitterli and d'Eon 2022): the
 //! collision depths of a path of directions integrated out analytically, for facets that
 //! reflect on one side (conductor, Lambertian, Hammon).
 //!
@@ -15,8 +15,8 @@
 //!   `psi' = sum_i lambda c_i / (lambda - beta_i) (e^{-beta_i tau} - e^{-lambda tau})`.
 //!
 //! The probability of escaping at the last step of a path (the survival fractions `1 - E` of
-//! its earlier upward steps times the last `E`) is the product of its rates times THEORY's
-//! depth factor `S`. Run on the chain of [`crate::chain`], which draws the
+//! its earlier upward steps times the last `E`) is the product of its rates times the
+//! depth factor `S` of docs/theory.md §7.1. Run on the chain of [`crate::chain`], which draws the
 //! directions as the walk does, this estimates exactly the walk's per-order lobes, without
 //! heights and with the escape event replaced by its probability. The profile is kept
 //! normalised to mass 1, so `E` is the fraction of the chain's current weight that escapes.

@@ -1,4 +1,4 @@
-//! Exact single scattering (THEORY.md §5): the expected order-1 output of the walk with the
+//! Exact single scattering (docs/theory.md §5): the expected order-1 output of the walk with the
 //! true Smith Lambda and visible normals. All functions return the cosine-weighted lobe
 //! `f_1(wi, wo) |cos theta_o|` (§0), with `wi` towards the light and `wo` towards the
 //! detector, both pointing away from the surface, in the frame where the light is outside.

@@ -1,4 +1,4 @@
-//! Slope-space integrals of GGX (THEORY.md §8.1, §8.2; Loubet et al. 2020 supplement).
+//! Slope-space integrals of GGX (docs/theory.md §8.1, §8.2; Loubet et al. 2020 supplement).
 //!
 //! In the stretched roughness-1 configuration the GGX slope density is a cosine lobe on the
 //! sphere, `P22 dX dY = (m·z)/pi dm`, and straight lines in slope space are great circles

@@ -1,4 +1,4 @@
-//! Which Smith `Lambda` drives the height process (THEORY.md §1.4, §2.4, §2.7).
+//! Which Smith `Lambda` drives the height process (docs/theory.md §1.4, §2.4, §2.7).
 
 use glam::DVec3;
 

@@ -1,4 +1,4 @@
-//! The random walk on the Smith microsurface (Heitz et al. 2016; THEORY.md §4.1, §4.6).
+//! The random walk on the Smith microsurface (Heitz et al. 2016; docs/theory.md §4.1, §4.6).
 //!
 //! A photon enters from the light's side at the top of the height support (optical depth 0)
 //! and alternates free flights in optical depth (§2.4) with facet interactions (§4.2–§4.5)

@@ -1,4 +1,4 @@
-//! The position-free multiple-bounce models of Wang et al. 2022 (THEORY.md §6), evaluated as
+//! The position-free multiple-bounce models of Wang et al. 2022 (docs/theory.md §6), evaluated as
 //! height-free chains of visible-normal scatterings ([`crate::chain`], §6.5).
 //!
 //! At vertex `j`, a direction `d_j` pointing away from the surface on its side escapes with a
