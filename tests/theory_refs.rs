@@ -15,10 +15,6 @@ use std::process::Command;
 
 const THEORY: &str = "docs/theory.md";
 
-/// Paths (relative to the repository root, with `/`) where the theory's old file name may still
-/// appear: `src/` and `configs/` are renamed separately. Empty it once they say docs/theory.md.
-const OLD_NAME_ALLOWED_UNDER: &[&str] = &["src/", "configs/"];
-
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
@@ -185,7 +181,7 @@ fn nothing_points_outside_the_repository_for_the_theory() {
                     offending.push(format!("{path}:{}: mentions {needle}", i + 1));
                 }
             }
-            if line.contains(&old_name) && !OLD_NAME_ALLOWED_UNDER.iter().any(|dir| path.starts_with(dir)) {
+            if line.contains(&old_name) {
                 offending.push(format!("{path}:{}: names {old_name} (the theory is {THEORY})", i + 1));
             }
         }

@@ -1,5 +1,5 @@
 //! `smithwalk compare`: a run's measured lobes against analytic models in the same bins, per
-//! case, order and hemisphere (THEORY.md §4.7, §9.5).
+//! case, order and hemisphere (docs/theory.md §4.7, §9.5).
 //!
 //! Models: `single` (exact single scattering by quadrature, order 1, every facet material with
 //! the true Smith Lambda and visible normals), `heitz-nee` (next-event

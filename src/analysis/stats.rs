@@ -1,4 +1,4 @@
-//! Statistical tests of weighted histograms (THEORY.md §9.5): chi-square against expected bin
+//! Statistical tests of weighted histograms (docs/theory.md §9.5): chi-square against expected bin
 //! integrals, two-sample chi-square of two Monte Carlo estimates, Sidak correction. Used by
 //! the test suite and by `smithwalk compare`.
 //!

@@ -1,5 +1,5 @@
 //! The virtual gonioreflectometer: angular histograms of escaping light per bounce order and
-//! hemisphere, with per-photon second moments for standard errors (THEORY.md §4.7).
+//! hemisphere, with per-photon second moments for standard errors (docs/theory.md §4.7).
 //!
 //! Sums are kept in 64.64 fixed point (`i128`). Integer addition is associative, so the
 //! totals do not depend on how photons are distributed over threads, chunks or machines:

@@ -297,7 +297,7 @@ where
 
 /// Builds the walker of a case and hands it to `f`. The case's height distribution does not
 /// enter: the walk runs in optical depth, where every height law gives the same walk
-/// (THEORY.md §2.1, §2.4).
+/// (docs/theory.md §2.1, §2.4).
 pub fn with_walker<T>(case: &Case, settings: &RunSettings, rgb: bool, f: impl FnOnce(&dyn CaseWalker) -> T) -> T {
     if rgb { with_ndf::<3, T>(case, settings, f) } else { with_ndf::<1, T>(case, settings, f) }
 }

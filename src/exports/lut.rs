@@ -1,5 +1,5 @@
 //! `smithwalk lut`: energy-compensation tables. The directional albedo E(mu, alpha) of the
-//! Smith microsurface per bounce order and for all orders (THEORY.md §9.4), and its cosine-
+//! Smith microsurface per bounce order and for all orders (docs/theory.md §9.4), and its cosine-
 //! weighted hemispherical average E_avg(alpha) = 2 ∫ E(mu) mu dmu, for the conductor with F = 1
 //! (the Kulla-Conty tables), the dielectric E(mu, alpha, eta) in reflection and transmission
 //! from both sides, and the `hammon` facet. Every value is a walk measurement with its

@@ -25,7 +25,7 @@
 //! - `luminance`, the sampling density over the square, is the lobe's luminance times
 //!   |d omega_o / d u| = 2 pi^2 u_x sin(theta_m) 4 (wi . m), so a renderer draws directions
 //!   nearly in proportion to the lobe.
-//! - `ndf` and `sigma` hold the surface's D(m) and projected area A(wi) (THEORY.md §1.2, §1.5)
+//! - `ndf` and `sigma` hold the surface's D(m) and projected area A(wi) (docs/theory.md §1.2, §1.5)
 //!   on the same u axis, for tools that read them.
 //!
 //! The lobe values come from [`Sweep::brdf`] at the swept incident angles themselves, so the

@@ -34,7 +34,7 @@ impl Case {
         DVec3::new(st * cp, st * sp, z)
     }
 
-    /// Whether the exact position-free form (THEORY.md §7.1) describes this case's walk: facets
+    /// Whether the exact position-free form (docs/theory.md §7.1) describes this case's walk: facets
     /// that reflect on one side, the true Smith Lambda and visible normals (the chain's laws).
     pub fn position_free_applies(&self) -> bool {
         !self.material.transmits() && self.smith == SmithKind::Exact && self.normals == NormalsKind::Vndf
