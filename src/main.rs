@@ -27,7 +27,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Simulate every case of a TOML config and write lobes.csv, summary.csv and run.json.
+    /// Simulate every case of a TOML config, write lobes.csv, summary.csv and run.json, and
+    /// print each case's energy balance (R, T, absorbed with its standard error, lost, the
+    /// highest order), with a legend of its columns.
     Run {
         /// The run configuration (TOML).
         config: PathBuf,

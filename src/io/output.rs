@@ -120,8 +120,8 @@ impl EnergyBalance {
 pub const BALANCE_LEGEND: &str = "\
 Energy balance per case, in fractions of the incident energy (per order: summary.csv):
   R, T       reflected and transmitted, all bounce orders
-  absorbed   1 - R - T - lost ± one standard error (a material that absorbs nothing shows
-             0 within its error: the noise of Russian roulette)
+  absorbed   1 - R - T - lost, ± its standard error (a material that absorbs nothing
+             shows 0 within the error: the noise of Russian roulette)
   lost       trapped at infinite depth, NaN or beyond 2^20 interactions (by reason: run.json)
   orders     highest bounce order that received light; K+ when detector.max_order = K folds
              the orders >= K into one\n";
