@@ -13,7 +13,7 @@ use smithwalk::engine::checkpoint::{self, Checkpointer};
 use smithwalk::engine::run::{Estimator, Shard};
 use smithwalk::engine::shard::write_shard;
 use smithwalk::exports::lut::LutConfig;
-use smithwalk::io::output::EnergyBalance;
+use smithwalk::io::output;
 use smithwalk::setup::config::Config;
 use smithwalk::setup::config::Model;
 use smithwalk::{RunOptions, Simulation};
@@ -27,7 +27,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Simulate every case of a TOML config and write lobes.csv, summary.csv and run.json.
+    /// Simulate every case of a TOML config, write lobes.csv, summary.csv and run.json, and
+    /// print each case's energy balance (R, T, absorbed with its standard error, lost, the
+    /// highest order), with a legend of its columns.
     Run {
         /// The run configuration (TOML).
         config: PathBuf,
@@ -385,7 +387,7 @@ fn report(sim: &Simulation, config: &Config, written: &[PathBuf]) -> Result<()> 
     Ok(())
 }
 
-/// The end summary: throughput and each case's energy balance (channel 0 for RGB runs).
+/// The end summary: throughput, then each case's energy balance with a legend of its columns.
 fn print_summary(sim: &Simulation, config: &Config, written: &[PathBuf]) -> std::io::Result<()> {
     let mut out = std::io::stdout().lock();
     let total = config.paths * sim.cases.len() as u64;
@@ -399,32 +401,7 @@ fn print_summary(sim: &Simulation, config: &Config, written: &[PathBuf]) -> std:
         sim.threads,
         rate / sim.threads as f64
     )?;
-    writeln!(
-        out,
-        "{:>5}  {:<48} {:>9} {:>9} {:>9} {:>9} {:>6}",
-        "case", "surface / material / incidence", "R", "T", "absorbed", "lost", "orders"
-    )?;
-    for (case, result) in sim.cases.iter().zip(&sim.results) {
-        let e = EnergyBalance::from_result(result);
-        let label = format!(
-            "{:?} a=({},{}) {} th={:.2}",
-            case.ndf,
-            case.alpha_x,
-            case.alpha_y,
-            case.material.label(),
-            case.theta_i_deg
-        );
-        writeln!(
-            out,
-            "{:>5}  {label:<48} {:>9.6} {:>9.6} {:>9.6} {:>9.2e} {:>6}",
-            case.index,
-            e.reflected[0],
-            e.transmitted[0],
-            e.absorbed[0],
-            e.lost(),
-            e.highest_order
-        )?;
-    }
+    write!(out, "{}{}", output::BALANCE_LEGEND, output::balance_table(sim))?;
     for path in written {
         writeln!(out, "wrote {}", path.display())?;
     }

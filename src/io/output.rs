@@ -11,7 +11,7 @@ use crate::engine::Simulation;
 use crate::engine::detector::{Detector, Hemisphere, Tally};
 use crate::engine::run::CaseResult;
 use crate::setup::cases::Case;
-use crate::setup::config::{Config, IncidentSide};
+use crate::setup::config::{Config, IncidentSide, NormalsKind, SmithKind};
 
 const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
 
@@ -116,6 +116,82 @@ impl EnergyBalance {
     }
 }
 
+/// What the columns of [`balance_table`] mean, printed once above it.
+pub const BALANCE_LEGEND: &str = "\
+Energy balance per case, in fractions of the incident energy (per order: summary.csv):
+  R, T       reflected and transmitted, all bounce orders
+  absorbed   1 - R - T - lost, ± its standard error (a material that absorbs nothing
+             shows 0 within the error: the noise of Russian roulette)
+  lost       trapped at infinite depth, NaN or beyond 2^20 interactions (by reason: run.json)
+  orders     highest bounce order that received light; K+ when detector.max_order = K folds
+             the orders >= K into one\n";
+
+/// The energy balance of every case as a text table (§9.2): the surface and material as the
+/// config spells them, one row per case and channel (RGB runs get a `channel` column), the
+/// absorbed fraction with its standard error. Columns `smith`, `normals` and `side` appear
+/// only when some case departs from their defaults.
+pub fn balance_table(sim: &Simulation) -> String {
+    let cases = &sim.cases;
+    let smith = cases.iter().any(|c| c.smith != SmithKind::Exact);
+    let normals = cases.iter().any(|c| c.normals != NormalsKind::Vndf);
+    let side = cases.iter().any(|c| c.side != IncidentSide::Outside);
+    let mut header = vec!["case", "ndf", "alpha"];
+    header.extend(smith.then_some("smith"));
+    header.extend(normals.then_some("normals"));
+    header.push("material");
+    header.extend(side.then_some("side"));
+    header.extend(sim.rgb.then_some("channel"));
+    // Names align left, numbers right.
+    let names = 1..header.len();
+    header.extend(["theta_i_deg", "R", "T", "absorbed", "lost", "orders"]);
+    let mut rows: Vec<Vec<String>> = vec![header.iter().map(|h| h.to_string()).collect()];
+    for (case, result) in cases.iter().zip(&sim.results) {
+        let e = EnergyBalance::from_result(result);
+        let alpha = if case.alpha_x == case.alpha_y {
+            case.alpha_x.to_string()
+        } else {
+            format!("[{}, {}]", case.alpha_x, case.alpha_y)
+        };
+        let folded = match result {
+            CaseResult::Mono(d) => d.is_folded(e.highest_order),
+            CaseResult::Rgb(d) => d.is_folded(e.highest_order),
+        };
+        let orders = format!("{}{}", e.highest_order, if folded { "+" } else { "" });
+        for (c, channel) in CHANNEL_NAMES.iter().enumerate().take(e.reflected.len()) {
+            let mut row = vec![case.index.to_string(), name(&case.ndf), alpha.clone()];
+            row.extend(smith.then(|| name(&case.smith)));
+            row.extend(normals.then(|| name(&case.normals)));
+            row.push(case.material.label());
+            row.extend(side.then(|| name(&case.side)));
+            row.extend(sim.rgb.then(|| channel.to_string()));
+            row.push(format!("{:.2}", case.theta_i_deg));
+            let lost = e.lost_trapped[c] + e.lost_invalid[c] + e.lost_runaway[c];
+            row.extend([
+                format!("{:.6}", e.reflected[c]),
+                format!("{:.6}", e.transmitted[c]),
+                format!("{:.6} ± {:.6}", e.absorbed[c], e.absorbed_stderr[c]),
+                format!("{lost:.6}"),
+                orders.clone(),
+            ]);
+            rows.push(row);
+        }
+    }
+    let widths: Vec<usize> =
+        (0..rows[0].len()).map(|i| rows.iter().map(|r| r[i].chars().count()).max().unwrap_or(0)).collect();
+    let mut text = String::new();
+    for row in &rows {
+        let cells: Vec<String> = row
+            .iter()
+            .zip(&widths)
+            .enumerate()
+            .map(|(i, (cell, &w))| if names.contains(&i) { format!("{cell:<w$}") } else { format!("{cell:>w$}") })
+            .collect();
+        text.push_str(cells.join("  ").trim_end());
+        text.push('\n');
+    }
+    text
+}
+
 fn channel_header(rgb: bool) -> Vec<&'static str> {
     if rgb { vec!["channel"] } else { vec![] }
 }
@@ -130,7 +206,11 @@ fn lobe_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Dete
             for ic in 0..grid.cos_bins {
                 let (lo, hi) = grid.cos_edges(ic);
                 let (cos_lo, cos_hi) = if sign > 0.0 { (lo, hi) } else { (-hi, -lo) };
-                let solid = grid.projected_solid_angle(ic);
+                let projected = grid.projected_solid_angle(ic);
+                // The bin's centre: the mid-point in cos theta (it halves the bin's solid angle)
+                // and in phi; the solid angle is delta phi times delta cos (§4.7).
+                let theta_deg = (0.5 * (cos_lo + cos_hi)).acos().to_degrees();
+                let solid_angle = (hi - lo) * std::f64::consts::TAU / grid.phi_bins as f64;
                 for ip in 0..grid.phi_bins {
                     let (phi_lo, phi_hi) = grid.phi_edges_deg(ip);
                     let tally = &tallies.bins[hemisphere as usize * grid.bins() + ic * grid.phi_bins + ip];
@@ -144,8 +224,9 @@ fn lobe_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Dete
                         }
                         row.extend([cos_lo, cos_hi, phi_lo, phi_hi, energy, se].map(|v| v.to_string()));
                         row.push(tally.count.to_string());
-                        row.push((energy / solid).to_string());
-                        row.push((se / solid).to_string());
+                        row.push((energy / projected).to_string());
+                        row.push((se / projected).to_string());
+                        row.extend([theta_deg, 0.5 * (phi_lo + phi_hi), solid_angle].map(|v| v.to_string()));
                         w.write_record(&row)?;
                     }
                 }
@@ -187,7 +268,9 @@ fn summary_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &D
     Ok(())
 }
 
-/// The CSV text of `lobes.csv` (one row per case, order, hemisphere, bin and channel).
+/// The CSV text of `lobes.csv`: one row per case, order slot (0 = all orders, then 1 up to the
+/// highest order that received light, or the folded `max_order` slot), hemisphere (`R`, and `T`
+/// for materials that transmit), bin (every bin, empty ones too) and channel (RGB runs).
 pub fn lobes_csv(sim: &Simulation) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header: Vec<&str> = CASE_COLUMNS.to_vec();
@@ -203,6 +286,9 @@ pub fn lobes_csv(sim: &Simulation) -> Result<Vec<u8>> {
         "count",
         "bsdf",
         "bsdf_stderr",
+        "theta_o_deg",
+        "phi_o_deg",
+        "solid_angle",
     ]);
     w.write_record(&header)?;
     for (case, result) in sim.cases.iter().zip(&sim.results) {
