@@ -2,7 +2,7 @@
 per-order lobes in the plane of incidence.
 
     pip install ./crates/python matplotlib pandas
-    python scripts/example.py                  # 10^6 photons per case, about 10 s on 2 cores
+    python scripts/example.py                  # 10^6 photons per case
     python scripts/example.py --paths 20000    # a quick look
 
 Writes OUT/run/ (the run directory, as `smithwalk run` and `smithwalk compare` write it) and
@@ -32,13 +32,15 @@ CONFIG = {
 MODELS = ["wang-correlated", "wang-uncorrelated"]
 
 
-def plane_of_incidence(values, phi_bins):
+def plane_of_incidence(values, phi_bins, stderr=False):
     """A lobe (cos_bin, phi_bin) in the plane of incidence: the two phi bins either side of the
-    mirror azimuth (180 deg) and of the incident one (0 deg), averaged; returns (back, mirror)."""
+    mirror azimuth (180 deg) and of the incident one (0 deg), averaged; returns (back, mirror).
+    With `stderr`, `values` are standard errors, combined as those of independent bins."""
     half = phi_bins // 2
-    mirror = values[:, [half - 1, half]].mean(axis=1)
-    back = values[:, [0, phi_bins - 1]].mean(axis=1)
-    return back, mirror
+    pairs = ([0, phi_bins - 1], [half - 1, half])
+    if stderr:
+        return tuple(np.sqrt((values[:, p] ** 2).sum(axis=1)) / 2 for p in pairs)
+    return tuple(values[:, p].mean(axis=1) for p in pairs)
 
 
 def signed_angles(cos_edges):
@@ -62,7 +64,7 @@ def main():
     columns = ["case", "model", "order", "albedo_measured", "albedo_measured_stderr", "albedo_model"]
     print(table[table["hemisphere"] == "R"][columns].to_string(index=False))
 
-    orders = [k for k in range(1, len(result.orders))]
+    orders = range(1, len(result.orders))  # slot 0 is all orders together
     phi_bins = len(result.phi_edges_deg) - 1
     back_x, mirror_x = signed_angles(result.cos_edges)
     fig, axes = plt.subplots(
@@ -72,14 +74,15 @@ def main():
     for j, case in enumerate(result.cases):
         for i, k in enumerate(orders):
             ax = axes[i, j]
-            walk = [plane_of_incidence(result.bsdf[j, k, 0], phi_bins)]
-            err = [plane_of_incidence(result.bsdf_stderr[j, k, 0], phi_bins)]
+            walk = plane_of_incidence(result.bsdf[j, k, 0], phi_bins)
+            err = plane_of_incidence(result.bsdf_stderr[j, k, 0], phi_bins, stderr=True)
+            models = {m: plane_of_incidence(comparison[m]["bsdf"][j, k, 0], phi_bins) for m in MODELS}
             for side, x in enumerate((back_x, mirror_x)):
-                ax.errorbar(x, walk[0][side], yerr=err[0][side], fmt=".", color="black", ms=3,
-                            label="walk" if side else None)
+                label = side == 1  # one legend entry per curve
+                ax.errorbar(x, walk[side], yerr=err[side], fmt=".", color="black", ms=3,
+                            label="walk" if label else None)
                 for m, color in zip(MODELS, ("tab:blue", "tab:orange")):
-                    model = plane_of_incidence(comparison[m]["bsdf"][j, k, 0], phi_bins)
-                    ax.plot(x, model[side], color=color, lw=1, label=m if side else None)
+                    ax.plot(x, models[m][side], color=color, lw=1, label=m if label else None)
             if i == 0:
                 ax.set_title(f"alpha {case['alpha_x']}, theta_i {case['theta_i_deg']:g} deg", fontsize=9)
             if j == 0:
