@@ -228,6 +228,8 @@ def test_ctrl_c_stops_a_run(tmp_path):
     out, err = child.communicate(timeout=60)
     assert child.returncode != 0
     assert "KeyboardInterrupt" in err and "finished" not in out
+    # Raised from inside the walk, not before it started.
+    assert "_native.run(" in err, err
     # One round is 32 chunks of 16 384 photons: well under a few seconds on one core.
     assert time.monotonic() - sent < 10
 
