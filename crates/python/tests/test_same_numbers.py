@@ -97,7 +97,7 @@ def test_load_reads_back_the_arrays_of_the_run(tmp_path):
         assert (tmp_path / "again" / name).read_bytes() == (tmp_path / "run" / name).read_bytes()
 
 
-def test_thread_count_does_not_change_the_arrays():
+def test_thread_count_and_progress_bar_do_not_change_the_arrays():
     one = smithwalk.run(RGB, threads=1)
-    three = smithwalk.run(RGB, threads=3)
+    three = smithwalk.run(RGB, threads=3, progress=True)
     assert np.array_equal(one.energy, three.energy) and np.array_equal(one.count, three.count)
