@@ -1,0 +1,438 @@
+//! The native half of the `smithwalk` Python package (`smithwalk._native`): runs a
+//! configuration with the GIL released and Ctrl-C checked between rounds, hands the detector's
+//! tallies over as numpy arrays, writes and reads run directories with the crate's own writers
+//! and readers, and runs the crate's `compare`. The Python half (`python/smithwalk/`) builds the
+//! user-facing objects on top of these functions.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
+use smithwalk::engine::detector::{Detector, Grid};
+use smithwalk::engine::run::{CaseResult, Estimator, Shard};
+use smithwalk::setup::config::{Config, ConfigError, Model};
+use smithwalk::{RunOptions, Simulation};
+
+/// The message the command line prints for an error (`error: {e:#}` without the prefix).
+fn message(e: impl Into<anyhow::Error>) -> String {
+    format!("{:#}", e.into())
+}
+
+/// A configuration error as Python sees it: `OSError` when the file cannot be read,
+/// `ValueError` otherwise, with the command line's message.
+fn config_error(e: ConfigError) -> PyErr {
+    match e {
+        ConfigError::Read { .. } => PyOSError::new_err(message(e)),
+        _ => PyValueError::new_err(message(e)),
+    }
+}
+
+fn runtime_error(e: anyhow::Error) -> PyErr {
+    PyRuntimeError::new_err(message(e))
+}
+
+/// Reads and validates a configuration given as `kind`: `"path"` (a TOML file), `"toml"` (TOML
+/// text) or `"json"` (a Python dict serialized as JSON, which is turned into TOML text so that
+/// it goes through exactly the parser and checks of a file).
+fn load_config(source: &str, kind: &str) -> PyResult<Config> {
+    let parsed = match kind {
+        "path" => Config::load(Path::new(source)),
+        "toml" => Config::parse(source),
+        "json" => {
+            let value: serde_json::Value =
+                serde_json::from_str(source).map_err(|e| PyValueError::new_err(format!("config dict: {e}")))?;
+            let text = toml::to_string(&value).map_err(|e| {
+                PyValueError::new_err(format!("config dict is not valid: {e} (values must be TOML values, not None)"))
+            })?;
+            Config::parse(&text).map_err(|e| match e {
+                ConfigError::Parse { message, .. } => ConfigError::Parse { path: "<dict>".into(), message },
+                other => other,
+            })
+        }
+        _ => return Err(PyValueError::new_err(format!("unknown config kind {kind:?}"))),
+    };
+    parsed.map_err(config_error)
+}
+
+/// A finished run: its resolved configuration and the simulation's measurements.
+#[pyclass(frozen, module = "smithwalk._native")]
+struct NativeRun {
+    config: Config,
+    sim: Simulation,
+}
+
+/// Runs every case of a configuration (`source` read as `kind`, see [`load_config`]) with the
+/// command line's overrides, the GIL released. After every round of chunks the walk takes the
+/// GIL back for a moment to let Python handle signals: Ctrl-C stops the run and raises
+/// `KeyboardInterrupt`, with nothing written.
+#[pyfunction]
+#[pyo3(signature = (source, kind, paths=None, seed=None, threads=None, progress=false))]
+fn run(
+    py: Python<'_>,
+    source: &str,
+    kind: &str,
+    paths: Option<u64>,
+    seed: Option<u64>,
+    threads: Option<usize>,
+    progress: bool,
+) -> PyResult<NativeRun> {
+    let mut config = load_config(source, kind)?;
+    if let Some(p) = paths {
+        config.paths = p;
+    }
+    if let Some(s) = seed {
+        config.seed = s;
+    }
+    config.validate().map_err(config_error)?;
+    if threads == Some(0) {
+        return Err(PyValueError::new_err("`threads` = 0 is not allowed: at least 1 thread"));
+    }
+    let options = RunOptions { shard: Shard::WHOLE, threads, show_progress: progress, estimator: Estimator::Walk };
+    let mut signal: Option<PyErr> = None;
+    let sim = py.detach(|| {
+        smithwalk::simulate_from(&config, &options, None, &mut |_, _, _| {
+            Python::attach(|py| py.check_signals()).map_err(|e| {
+                signal = Some(e);
+                anyhow::anyhow!("interrupted")
+            })
+        })
+    });
+    match (sim, signal) {
+        (_, Some(e)) => Err(e),
+        (Ok(sim), None) => Ok(NativeRun { config, sim }),
+        (Err(e), None) => Err(runtime_error(e)),
+    }
+}
+
+/// Per-bin arrays of one source (the measurement or a model), flat in the order of the shape
+/// `(case, order, hemisphere, cos_bin, phi_bin[, channel])`.
+struct BinArrays {
+    shape: Vec<usize>,
+    columns: BTreeMap<&'static str, Vec<f64>>,
+    count: Option<Vec<u64>>,
+}
+
+impl BinArrays {
+    fn new(shape: Vec<usize>, columns: &[&'static str], with_count: bool) -> Self {
+        let n = shape.iter().product();
+        Self {
+            shape,
+            columns: columns.iter().map(|&c| (c, vec![0.0; n])).collect(),
+            count: with_count.then(|| vec![0; n]),
+        }
+    }
+
+    fn into_dict<'py>(self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let dict = PyDict::new(py);
+        let shape = self.shape;
+        for (name, values) in self.columns {
+            dict.set_item(name, PyArray1::from_vec(py, values).reshape(shape.clone())?)?;
+        }
+        if let Some(count) = self.count {
+            dict.set_item("count", PyArray1::from_vec(py, count).reshape(shape)?)?;
+        }
+        Ok(dict)
+    }
+}
+
+/// The shape of a run's arrays, with the channel axis only for RGB runs.
+fn shape(cases: usize, orders: usize, grid: Grid, channels: Option<usize>) -> Vec<usize> {
+    let mut shape = vec![cases, orders, 2, grid.cos_bins, grid.phi_bins];
+    shape.extend(channels);
+    shape
+}
+
+const MEASURED: [&str; 4] = ["energy", "energy_stderr", "bsdf", "bsdf_stderr"];
+
+/// Copies one case's detector into the arrays: the same means, standard errors, counts and
+/// projected solid angles that `lobes.csv` is written from.
+fn fill<const C: usize>(d: &Detector<C>, case: usize, arrays: &mut BinArrays) {
+    let grid = d.grid;
+    let orders = arrays.shape[1];
+    let n = d.tallies.photons;
+    for (slot, tallies) in d.tallies.orders.iter().enumerate() {
+        for (i, tally) in tallies.bins.iter().enumerate() {
+            // `i` runs over hemisphere, cos bin and phi bin, the arrays' next three axes.
+            let solid = grid.projected_solid_angle(i % grid.bins() / grid.phi_bins);
+            for c in 0..C {
+                let at = ((case * orders + slot) * 2 * grid.bins() + i) * C + c;
+                let (energy, se) = tally.mean_and_stderr(n, c);
+                for (name, value) in MEASURED.into_iter().zip([energy, se, energy / solid, se / solid]) {
+                    arrays.columns.get_mut(name).expect("a measured column")[at] = value;
+                }
+                arrays.count.as_mut().expect("measured counts")[at] = tally.count;
+            }
+        }
+    }
+}
+
+#[pymethods]
+impl NativeRun {
+    /// The measured lobes as a dict of arrays shaped `(case, order, hemisphere, cos_bin,
+    /// phi_bin[, channel])`: `energy`, `energy_stderr`, `bsdf`, `bsdf_stderr` (float64) and
+    /// `count` (uint64). Orders a case never reached are zero.
+    fn lobes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let orders = self.sim.results.iter().map(|r| highest_slot(r) + 1).max().unwrap_or(1);
+        let grid = Grid { cos_bins: self.config.detector.cos_theta_bins, phi_bins: self.config.detector.phi_bins };
+        let channels = self.sim.rgb.then_some(3);
+        let mut arrays = BinArrays::new(shape(self.sim.cases.len(), orders, grid, channels), &MEASURED, true);
+        for (case, result) in self.sim.results.iter().enumerate() {
+            match result {
+                CaseResult::Mono(d) => fill(d, case, &mut arrays),
+                CaseResult::Rgb(d) => fill(d, case, &mut arrays),
+            }
+        }
+        arrays.into_dict(py)
+    }
+
+    /// The text of `summary.csv`.
+    fn summary_csv<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let bytes = smithwalk::io::output::summary_csv(&self.sim).map_err(runtime_error)?;
+        Ok(PyBytes::new(py, &bytes))
+    }
+
+    /// The text of `run.json`.
+    fn run_json<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let bytes = smithwalk::io::output::run_json(&self.sim, &self.config).map_err(runtime_error)?;
+        Ok(PyBytes::new(py, &bytes))
+    }
+
+    /// Writes `lobes.csv`, `summary.csv` and `run.json` into `dir` with the command line's
+    /// writer (atomically); returns the paths written.
+    fn save(&self, py: Python<'_>, dir: PathBuf) -> PyResult<Vec<PathBuf>> {
+        py.detach(|| {
+            smithwalk::atomic::prepare_dir(&dir)?;
+            smithwalk::write_outputs(&self.sim, &self.config, &dir)
+        })
+        .map_err(|e| PyOSError::new_err(message(e)))
+    }
+}
+
+fn highest_slot(r: &CaseResult) -> usize {
+    match r {
+        CaseResult::Mono(d) => d.highest_slot(),
+        CaseResult::Rgb(d) => d.highest_slot(),
+    }
+}
+
+/// The resolved, validated config of a run directory (from its `run.json`), as JSON text.
+#[pyfunction]
+fn read_config(dir: PathBuf) -> PyResult<String> {
+    let config = smithwalk::io::rundir::read_config(&dir).map_err(|e| PyValueError::new_err(message(e)))?;
+    serde_json::to_string(&config).map_err(|e| runtime_error(e.into()))
+}
+
+/// The columns of a bin table (`lobes.csv` or `models.csv`) that [`read_bins`] needs.
+struct BinColumns {
+    case: usize,
+    model: Option<usize>,
+    order: usize,
+    hemisphere: usize,
+    channel: Option<usize>,
+    cos_lo: usize,
+    cos_hi: usize,
+    phi_lo: usize,
+    count: Option<usize>,
+    values: Vec<(&'static str, usize)>,
+}
+
+impl BinColumns {
+    fn of(headers: &csv::StringRecord) -> anyhow::Result<Self> {
+        let find = |name: &str| headers.iter().position(|h| h == name);
+        let need = |name: &str| find(name).with_context(|| format!("no column {name}"));
+        let values = ["energy", "energy_stderr", "bsdf", "bsdf_stderr"]
+            .into_iter()
+            .filter_map(|name| find(name).map(|i| (name, i)))
+            .collect();
+        Ok(Self {
+            case: need("case")?,
+            model: find("model"),
+            order: need("order")?,
+            hemisphere: need("hemisphere")?,
+            channel: find("channel"),
+            cos_lo: need("cos_lo")?,
+            cos_hi: need("cos_hi")?,
+            phi_lo: need("phi_lo_deg")?,
+            count: find("count"),
+            values,
+        })
+    }
+}
+
+/// One parsed row of a bin table: its source, position in the arrays and values.
+struct BinRow {
+    model: String,
+    index: [usize; 5],
+    channel: usize,
+    values: Vec<f64>,
+    count: u64,
+}
+
+fn parse_row(c: &BinColumns, r: &csv::StringRecord, grid: Grid) -> anyhow::Result<BinRow> {
+    let number =
+        |i: usize| -> anyhow::Result<f64> { r[i].parse().with_context(|| format!("not a number: {:?}", &r[i])) };
+    let hemisphere = match &r[c.hemisphere] {
+        "R" => 0,
+        "T" => 1,
+        other => anyhow::bail!("hemisphere {other:?} is not R or T"),
+    };
+    // |cos| of the bin's centre finds its cos index in either hemisphere.
+    let ic = ((0.5 * (number(c.cos_lo)? + number(c.cos_hi)?)).abs() * grid.cos_bins as f64) as usize;
+    let ip = (number(c.phi_lo)? / 360.0 * grid.phi_bins as f64).round() as usize;
+    anyhow::ensure!(
+        ic < grid.cos_bins && ip < grid.phi_bins,
+        "a bin outside the run's {} x {} grid",
+        grid.cos_bins,
+        grid.phi_bins
+    );
+    let channel = match c.channel.map(|i| &r[i]) {
+        None | Some("r") => 0,
+        Some("g") => 1,
+        Some("b") => 2,
+        Some(other) => anyhow::bail!("channel {other:?} is not r, g or b"),
+    };
+    Ok(BinRow {
+        model: c.model.map_or(String::new(), |i| r[i].to_string()),
+        index: [r[c.case].parse()?, r[c.order].parse()?, hemisphere, ic, ip],
+        channel,
+        values: c.values.iter().map(|&(_, i)| number(i)).collect::<anyhow::Result<_>>()?,
+        count: c.count.map(|i| r[i].parse()).transpose()?.unwrap_or(0),
+    })
+}
+
+/// Reads a bin table of a run with `cases` cases on a `cos_bins` x `phi_bins` grid into arrays
+/// per model name (`""` for `lobes.csv`), shaped `(case, order, hemisphere, cos_bin, phi_bin[,
+/// channel])` with as many orders as the table has; bins without a row are zero.
+#[pyfunction]
+fn read_bins<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    cases: usize,
+    cos_bins: usize,
+    phi_bins: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let grid = Grid { cos_bins, phi_bins };
+    let parsed = py.detach(|| -> anyhow::Result<_> {
+        let mut reader = csv::Reader::from_path(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        let columns = BinColumns::of(reader.headers()?).with_context(|| path.display().to_string())?;
+        let rows = reader
+            .records()
+            .enumerate()
+            .map(|(line, r)| {
+                r.map_err(anyhow::Error::from)
+                    .and_then(|r| parse_row(&columns, &r, grid))
+                    .with_context(|| format!("{}: row {}", path.display(), line + 2))
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let mut by_model: BTreeMap<String, Vec<BinRow>> = BTreeMap::new();
+        for row in rows {
+            anyhow::ensure!(row.index[0] < cases, "{}: case {} of a run with {cases}", path.display(), row.index[0]);
+            by_model.entry(row.model.clone()).or_default().push(row);
+        }
+        let names: Vec<&'static str> = columns.values.iter().map(|&(name, _)| name).collect();
+        let channels = columns.channel.map(|_| 3);
+        Ok(by_model
+            .into_iter()
+            .map(|(model, rows)| {
+                let orders = rows.iter().map(|r| r.index[1] + 1).max().unwrap_or(1);
+                let mut arrays = BinArrays::new(shape(cases, orders, grid, channels), &names, columns.count.is_some());
+                for row in rows {
+                    let [case, order, hemisphere, ic, ip] = row.index;
+                    let bin = ((((case * orders + order) * 2 + hemisphere) * cos_bins + ic) * phi_bins) + ip;
+                    let at = bin * channels.unwrap_or(1) + row.channel;
+                    for (&name, value) in names.iter().zip(row.values) {
+                        arrays.columns.get_mut(name).expect("a parsed column")[at] = value;
+                    }
+                    if let Some(count) = arrays.count.as_mut() {
+                        count[at] = row.count;
+                    }
+                }
+                (model, arrays)
+            })
+            .collect::<Vec<_>>())
+    });
+    let dict = PyDict::new(py);
+    for (model, arrays) in parsed.map_err(|e| PyValueError::new_err(message(e)))? {
+        dict.set_item(model, arrays.into_dict(py)?)?;
+    }
+    Ok(dict)
+}
+
+type Array<'py> = Bound<'py, PyArray1<f64>>;
+
+/// The detector grid of a run: `(cos_edges, phi_edges_deg, projected_solid_angle)`, bin edges
+/// in |cos theta| and in degrees from the incident azimuth, and each cos bin's projected solid
+/// angle `∫ |cos theta| dω` (per phi bin), the divisor that turns `energy` into `bsdf`.
+#[pyfunction]
+fn grid<'py>(py: Python<'py>, cos_bins: usize, phi_bins: usize) -> (Array<'py>, Array<'py>, Array<'py>) {
+    let grid = Grid { cos_bins, phi_bins };
+    let edges = |n: usize, edge: &dyn Fn(usize) -> (f64, f64)| {
+        (0..n).map(|i| edge(i).0).chain(std::iter::once(edge(n - 1).1)).collect::<Vec<f64>>()
+    };
+    (
+        PyArray1::from_vec(py, edges(cos_bins, &|i| grid.cos_edges(i))),
+        PyArray1::from_vec(py, edges(phi_bins, &|i| grid.phi_edges_deg(i))),
+        PyArray1::from_vec(py, (0..cos_bins).map(|i| grid.projected_solid_angle(i)).collect()),
+    )
+}
+
+/// Runs `smithwalk compare` on a run directory (writes `models.csv` and `compare.csv` into it)
+/// with the GIL released; returns the report the command prints.
+#[pyfunction]
+#[pyo3(signature = (dir, models, paths=None, threads=None))]
+fn compare(
+    py: Python<'_>,
+    dir: PathBuf,
+    models: Vec<String>,
+    paths: Option<u64>,
+    threads: Option<usize>,
+) -> PyResult<String> {
+    let models =
+        models.iter().map(|m| Model::parse(m)).collect::<Result<Vec<_>, _>>().map_err(PyValueError::new_err)?;
+    if paths.is_some_and(|p| p < 2) {
+        return Err(PyValueError::new_err(format!(
+            "`paths` = {} is not allowed: at least 2 photons per case",
+            paths.unwrap_or(0)
+        )));
+    }
+    if threads == Some(0) {
+        return Err(PyValueError::new_err("`threads` = 0 is not allowed: at least 1 thread"));
+    }
+    py.detach(|| smithwalk::analysis::compare::compare(&dir, &models, paths, threads)).map_err(runtime_error)
+}
+
+/// Writes files (name, bytes) into `dir` atomically: all of them or none.
+#[pyfunction]
+fn write_files(py: Python<'_>, dir: PathBuf, files: Vec<(String, Vec<u8>)>) -> PyResult<Vec<PathBuf>> {
+    py.detach(|| {
+        smithwalk::atomic::prepare_dir(&dir)?;
+        let (names, bytes): (Vec<String>, Vec<Vec<u8>>) = files.into_iter().unzip();
+        let files: Vec<(&str, Vec<u8>)> = names.iter().map(String::as_str).zip(bytes).collect();
+        smithwalk::atomic::write_atomically(&dir, &files)
+    })
+    .map_err(|e| PyOSError::new_err(message(e)))
+}
+
+/// The names of the comparison models, in the command line's order.
+#[pyfunction]
+fn model_names() -> Vec<&'static str> {
+    Model::ALL.iter().map(|m| m.name()).collect()
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<NativeRun>()?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(read_config, m)?)?;
+    m.add_function(wrap_pyfunction!(read_bins, m)?)?;
+    m.add_function(wrap_pyfunction!(grid, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(write_files, m)?)?;
+    m.add_function(wrap_pyfunction!(model_names, m)?)?;
+    Ok(())
+}

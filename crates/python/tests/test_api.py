@@ -1,0 +1,271 @@
+"""The Python API: config forms, shapes and dtypes, labels, errors with the command line's
+messages, comparisons, the GIL, Ctrl-C, life without pandas, docstrings."""
+
+import inspect
+import pydoc
+import signal
+import subprocess
+import sys
+import threading
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import smithwalk
+from conftest import MONO, RGB, REPO
+
+FIELDS = ("energy", "energy_stderr", "count", "bsdf", "bsdf_stderr")
+
+
+@pytest.fixture(scope="module")
+def mono():
+    return smithwalk.run(MONO)
+
+
+def test_shapes_dtypes_and_labels(mono):
+    # 8 cases (2 alphas x 2 materials x 2 angles), slots all, 1, 2, 3+, R and T, 6 x 10 bins.
+    for name in FIELDS:
+        a = getattr(mono, name)
+        assert a.shape == (8, 4, 2, 6, 10), name
+        assert a.dtype == (np.uint64 if name == "count" else np.float64), name
+        assert a.flags.c_contiguous and a.flags.writeable, name
+    assert mono.orders == ("all", "1", "2", "3+")
+    assert mono.folded.tolist() == [False, False, False, True]
+    assert mono.hemispheres == ("R", "T") and mono.channels is None
+    assert np.array_equal(mono.cos_edges, np.arange(7) / 6)
+    assert np.array_equal(mono.phi_edges_deg, np.arange(11) * 36.0)
+    # Projected solid angle of a bin: 2 pi / phi_bins * (hi^2 - lo^2) / 2; over the hemisphere, pi.
+    assert mono.projected_solid_angle.sum() * 10 == pytest.approx(np.pi, rel=1e-14)
+    assert np.array_equal(mono.bsdf, mono.energy / mono.projected_solid_angle[:, None])
+    assert len(mono.cases) == 8
+    assert [c["theta_i_deg"] for c in mono.cases[:2]] == [20.0, 70.0]
+    assert mono.cases[0]["alpha_x"] == 0.3 and mono.cases[4]["alpha_y"] == 0.2
+    assert {"reflected", "transmitted", "absorbed"} <= mono.cases[0]["energy"].keys()
+    assert mono.info["paths"] == 40_000 and mono.info["seed"] == 7
+    # Conductors do not transmit.
+    assert not mono.energy[:2, :, 1].any() and mono.energy[2:4, :, 1].any()
+
+
+def test_rgb_runs_have_a_channel_axis():
+    r = smithwalk.run(RGB)
+    assert r.channels == ("r", "g", "b")
+    assert r.energy.shape[2:] == (2, 4, 8, 3) and r.count.shape == r.energy.shape
+    assert r.orders[:2] == ("all", "1") and not r.folded.any()
+    # A diffuse facet of albedo (0.9, 0.5, 0.1): the channels reflect in that order.
+    albedo = r.energy[0, 0, 0].sum(axis=(0, 1))
+    assert albedo[0] > albedo[1] > albedo[2] > 0
+
+
+def test_the_config_can_be_a_path_text_or_dict(tmp_path, mono):
+    path = tmp_path / "mono.toml"
+    path.write_text(MONO)
+    as_dict = tomllib.loads(MONO)
+    # numpy values in a dict are accepted.
+    as_dict["incident"]["theta_deg"] = np.array([20.0, 70.0])
+    as_dict["paths"] = np.int64(as_dict["paths"])
+    for config in (path, str(path), as_dict):
+        other = smithwalk.run(config)
+        assert np.array_equal(other.energy, mono.energy), type(config)
+    assert smithwalk.run(as_dict, paths=20_000, seed=8).info["seed"] == 8
+
+
+def test_summary_is_a_dataframe(mono):
+    pd = pytest.importorskip("pandas")
+    s = mono.summary
+    assert isinstance(s, pd.DataFrame)
+    assert s["albedo"].dtype == np.float64 and s["folded"].dtype == bool
+    assert set(s["hemisphere"]) == {"R", "T", "absorbed", "lost"}
+    conductor = s[(s["case"] == 0) & (s["hemisphere"] == "R") & (s["order"] == 0)]
+    assert conductor["albedo"].iloc[0] == pytest.approx(mono.energy[0, 0, 0].sum(), rel=1e-12)
+
+
+def test_without_pandas_tables_are_dicts_of_arrays(mono, monkeypatch):
+    frame = mono.summary
+    monkeypatch.setitem(sys.modules, "pandas", None)
+    plain = smithwalk.run(MONO).summary
+    assert isinstance(plain, dict) and list(plain) == list(frame.columns)
+    for name, column in plain.items():
+        assert column.tolist() == frame[name].tolist(), name
+    assert plain["case"].dtype == np.int64 and plain["folded"].dtype == bool
+
+
+def cli_message(cli, config_path):
+    done = cli("run", config_path, "--out", config_path.parent / "out", check=False)
+    assert done.returncode != 0 and done.stderr.startswith("error: ") and done.stderr.endswith("\n")
+    assert not (config_path.parent / "out" / "lobes.csv").exists()
+    # `error: {message}` and the newline of eprintln.
+    return done.stderr[len("error: ") : -1]
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        ("alpha = [0.3, [0.8, 0.2]]", "alpha = [0.3, 0.0]"),
+        ("theta_deg = [20, 70]", "theta_deg = [20, 90]"),
+        ("eta = 1.5", "eta = 1.0"),
+        ("max_order = 3", "max_order = 0"),
+        ("phi_bins = 10", "phi_bins = 10\nspin = 3"),
+        ("paths = 40_000", "paths = 1"),
+        ('fresnel = "schlick"', 'fresnel = "schlik"'),
+    ],
+)
+def test_invalid_configs_raise_value_error_with_the_cli_message(cli, write_config, change):
+    path = write_config(MONO.replace(*change))
+    expected = cli_message(cli, path)
+    with pytest.raises(ValueError) as error:
+        smithwalk.run(path)
+    assert str(error.value) == expected
+    # The same error from TOML text and from a dict, past the config's name.
+    with pytest.raises(ValueError) as error:
+        smithwalk.run(path.read_text())
+    assert str(error.value).replace("<text>", str(path)) == expected
+    try:
+        as_dict = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError:
+        return
+    with pytest.raises(ValueError) as error:
+        smithwalk.run(as_dict)
+    if not expected.startswith("config "):
+        assert str(error.value) == expected
+
+
+def test_bad_arguments(tmp_path):
+    with pytest.raises(ValueError, match=r"`paths` = 1 is not allowed"):
+        smithwalk.run(MONO, paths=1)
+    with pytest.raises(ValueError, match=r"`threads` = 0 is not allowed"):
+        smithwalk.run(MONO, threads=0)
+    with pytest.raises(ValueError, match=r"`seed` = -1 is not allowed"):
+        smithwalk.run(MONO, seed=-1)
+    with pytest.raises(TypeError, match="must be an integer"):
+        smithwalk.run(MONO, paths=1e5)
+    with pytest.raises(TypeError, match="TOML string, a path or a dict"):
+        smithwalk.run(42)
+    with pytest.raises(OSError, match="cannot read config"):
+        smithwalk.run(tmp_path / "missing.toml")
+    with pytest.raises(ValueError, match="is not TOML|not valid"):
+        smithwalk.run({"paths": 1000, "surface": {"alpha": None}})
+    with pytest.raises(ValueError, match="run.json"):
+        smithwalk.load(tmp_path)
+
+
+def test_compare_matches_the_command_line(cli, tmp_path):
+    result = smithwalk.run(MONO, paths=20_000)
+    comparison = result.compare(["single", "wang-correlated"], paths=20_000, threads=2)
+    assert comparison is result.comparison and comparison.models == ("single", "wang-correlated")
+    assert set(comparison.lobes) == {"single", "wang-correlated"}
+    for model, lobes in comparison.lobes.items():
+        assert set(lobes) == {"energy", "energy_stderr", "bsdf"}
+        for a in lobes.values():
+            assert a.shape == result.energy.shape and a.dtype == np.float64, model
+    # Exact single scattering has order 1 only, for every case.
+    single = comparison["single"]["energy"]
+    assert single[:, 1].any() and not single[:, 2:].any()
+    table = comparison.table
+    assert set(table["model"]) == {"single", "wang-correlated"}
+    assert "wang-correlated" in comparison.report
+    # The same files as `smithwalk compare` on the saved run.
+    result.save(tmp_path / "py")
+    (tmp_path / "cli").mkdir()
+    for name in ("lobes.csv", "summary.csv", "run.json"):
+        (tmp_path / "cli" / name).write_bytes((tmp_path / "py" / name).read_bytes())
+    cli("compare", tmp_path / "cli", "--models", "single,wang-correlated", "--paths", 20_000)
+    for name in ("models.csv", "compare.csv"):
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
+    # And a loaded run carries its comparison.
+    loaded = smithwalk.load(tmp_path / "py")
+    assert loaded.comparison.models == ("single", "wang-correlated")
+    for model in comparison.models:
+        assert np.array_equal(loaded.comparison[model]["energy"], comparison[model]["energy"])
+    again = loaded.compare("single")
+    assert np.array_equal(again["single"]["bsdf"], comparison["single"]["bsdf"])
+    with pytest.raises(ValueError, match='"wang" is not a model; allowed: single'):
+        result.compare(["wang"])
+
+
+def test_a_compare_table_in_the_config_runs_the_comparison():
+    result = smithwalk.run(RGB + '\n[compare]\nmodels = ["single"]\n', paths=5_000)
+    assert result.comparison.models == ("single",)
+    assert result.comparison["single"]["energy"].shape == result.energy.shape
+
+
+def test_the_walk_releases_the_gil():
+    """Another Python thread keeps running while a run is walking."""
+    ticks = 0
+    done = threading.Event()
+
+    def walk():
+        smithwalk.run(MONO, paths=600_000, threads=1)
+        done.set()
+
+    thread = threading.Thread(target=walk)
+    thread.start()
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0.001)
+    thread.join()
+    # 8 cases of 600 000 photons take over a second; with the GIL held the loop would stall.
+    assert ticks > 100
+
+
+def test_ctrl_c_stops_a_run(tmp_path):
+    """SIGINT in the middle of a long run raises KeyboardInterrupt within a round of chunks."""
+    script = (
+        "import sys, smithwalk\n"
+        "print('walking', flush=True)\n"
+        f"smithwalk.run({MONO!r}, paths=10**9, threads=1)\n"
+        "print('finished', flush=True)\n"
+    )
+    child = subprocess.Popen(
+        [sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    assert child.stdout.readline().strip() == "walking"
+    time.sleep(1.5)
+    child.send_signal(signal.SIGINT)
+    sent = time.monotonic()
+    out, err = child.communicate(timeout=60)
+    assert child.returncode != 0
+    assert "KeyboardInterrupt" in err and "finished" not in out
+    # Raised from inside the walk, not before it started.
+    assert "_native.run(" in err, err
+    # One round is 32 chunks of 16 384 photons: well under a few seconds on one core.
+    assert time.monotonic() - sent < 10
+
+
+def test_help_shows_numpy_style_docstrings():
+    text = pydoc.render_doc(smithwalk, renderer=pydoc.plaintext)
+    needles = (
+        "run(config, *, paths=None, seed=None, threads=None, progress=False)",
+        "load(path)",
+        "class RunResult",
+        "compare(self, models=None, *, paths=None, threads=None)",
+        "class Comparison",
+        "Parameters",
+        "Returns",
+    )
+    for needle in needles:
+        assert needle in text, needle
+    for item in (smithwalk.run, smithwalk.load, smithwalk.RunResult.compare, smithwalk.RunResult.save):
+        assert "Parameters\n----------" in inspect.cleandoc(item.__doc__), item.__name__
+    assert smithwalk.MODELS[0] == "single" and len(smithwalk.MODELS) == 6
+
+
+def test_the_example_runs_and_plots(tmp_path):
+    pytest.importorskip("matplotlib")
+    script = REPO / "scripts" / "example.py"
+    done = subprocess.run(
+        [sys.executable, str(script), "--paths", "20000", "--out", str(tmp_path)],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    png = tmp_path / "lobes.png"
+    import matplotlib.image
+
+    image = matplotlib.image.imread(png)
+    assert image.shape[0] > 300 and image.shape[1] > 300
+    assert image[..., :3].std() > 0.05  # drawn, not blank
+    assert (tmp_path / "run" / "compare.csv").exists()
+    assert "wang-correlated" in done.stdout
