@@ -8,15 +8,12 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::style::{self, FONT, Figure, Key, LABEL, TICK, TITLE, draw_err};
+use super::style::{self, CAPTION, FONT, Figure, Key, TICK, draw_err};
 use super::{Points, Selection, groups, pretty_fields, slot_label};
 use crate::io::rundir::{RunDir, SummaryRow};
 use crate::setup::cases::Case;
 
 const PANEL: (u32, u32) = (360, 260);
-const TOP: u32 = 78;
-const LEFT: u32 = 30;
-const BOTTOM: u32 = 34;
 const MAX_COLUMNS: usize = 4;
 
 /// The parameter on the x axis.
@@ -151,7 +148,7 @@ impl<'a> AlbedoFigure<'a> {
         let top = orders.values().flatten().map(|p| p.1 + p.2).fold(0.0_f64, f64::max).max(1e-9) * 1.08;
         let (x_decimals, y_decimals) = (style::tick_decimals(lo - pad, hi + pad, 6), style::tick_decimals(0.0, top, 5));
         let mut chart = ChartBuilder::on(area)
-            .caption(caption, (FONT, TICK))
+            .caption(caption, (FONT, CAPTION))
             .margin(6)
             .margin_right(14)
             .x_label_area_size(26)
@@ -191,32 +188,19 @@ impl<'a> AlbedoFigure<'a> {
 
 impl Figure for AlbedoFigure<'_> {
     fn size(&self) -> (u32, u32) {
-        let (cols, rows) = self.grid();
-        (LEFT + PANEL.0 * cols as u32, TOP + PANEL.1 * rows as u32 + BOTTOM)
+        style::grid_size(PANEL, self.grid())
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
-        let (width, height) = self.size();
         let title = match self.sweep {
             Sweep::Theta => "Albedo per bounce order against the incident angle",
             Sweep::Alpha => "Albedo per bounce order against the roughness",
         };
-        style::draw_centred(
-            root,
-            &format!("{title}{}", self.selection.suffix()),
-            (width as i32 / 2, 18),
-            TITLE,
-            false,
-        )?;
+        let title = format!("{title}{}", self.selection.suffix());
         let legend: Vec<(Key, String)> =
             self.slots().into_iter().map(|s| (Key::Line(style::order_style(s)), slot_label(self.run, s))).collect();
-        style::draw_legend(&root.margin(38, 0, 0, 0).shrink((0, 0), (width, 36)), &legend)?;
-        let panels_height = height - TOP - BOTTOM;
-        style::draw_centred(root, "albedo", (LEFT as i32 / 2, (TOP + panels_height / 2) as i32), LABEL, true)?;
-        let x_at = ((LEFT + (width - LEFT) / 2) as i32, (height - BOTTOM / 2) as i32);
-        style::draw_centred(root, self.sweep.axis(), x_at, LABEL, false)?;
-        let (cols, rows) = self.grid();
-        for (area, panel) in root.margin(TOP, BOTTOM, LEFT, 0).split_evenly((rows, cols)).iter().zip(&self.panels) {
+        let labels = style::GridLabels { title: &title, legend: &legend, y: "albedo", x: self.sweep.axis() };
+        for (area, panel) in style::draw_grid(root, &labels, self.grid())?.iter().zip(&self.panels) {
             self.panel(area, panel)?;
         }
         Ok(())

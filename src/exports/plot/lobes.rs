@@ -9,16 +9,12 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::style::{self, CAPTION, FONT, Figure, Key, LABEL, MEASURED, TICK, TITLE, draw_err};
+use super::style::{self, CAPTION, FONT, Figure, Key, MEASURED, TICK, draw_err};
 use super::{Points, Selection, plane_of_incidence, slot_label, surface_label};
 use crate::io::rundir::{Lobes, RunDir};
 use crate::setup::cases::Case;
 
 const PANEL: (u32, u32) = (330, 250);
-/// Bands around the panels: title, legend, the shared y label on the left and x label below.
-const TOP: u32 = 78;
-const LEFT: u32 = 30;
-const BOTTOM: u32 = 34;
 /// The most incident angles side by side before a sweep wraps into another block of rows.
 const MAX_COLUMNS: usize = 5;
 
@@ -139,32 +135,22 @@ impl LobeFigure<'_> {
 
 impl Figure for LobeFigure<'_> {
     fn size(&self) -> (u32, u32) {
-        let (cols, rows) = self.grid();
-        (LEFT + PANEL.0 * cols as u32, TOP + PANEL.1 * rows as u32 + BOTTOM)
+        style::grid_size(PANEL, self.grid())
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
-        let (width, height) = self.size();
         let hemisphere = if self.hemisphere == "T" { "transmission (T)" } else { "reflection (R)" };
         let title = format!("{}: {hemisphere}{}", surface_label(self.cases[0]), self.selection.suffix());
-        style::draw_centred(root, &title, (width as i32 / 2, 18), TITLE, false)?;
         let mut legend = vec![(Key::Measured, "random walk (±1 SE)".to_string())];
         legend.extend(self.models_drawn().into_iter().map(|m| (Key::Line(style::model_style_by_name(m)), m.clone())));
-        style::draw_legend(&root.margin(38, 0, 0, 0).shrink((0, 0), (width, 36)), &legend)?;
-        let y_label = "f·|cos θ_o| (1/sr)";
-        let panels_height = height - TOP - BOTTOM;
-        style::draw_centred(root, y_label, (LEFT as i32 / 2, (TOP + panels_height / 2) as i32), LABEL, true)?;
-        let x_label = "θ_o (deg), + mirror side, − light's side (plane of incidence)";
-        style::draw_centred(
-            root,
-            x_label,
-            ((LEFT + (width - LEFT) / 2) as i32, (height - BOTTOM / 2) as i32),
-            LABEL,
-            false,
-        )?;
-        let body = root.margin(TOP, BOTTOM, LEFT, 0);
+        let labels = style::GridLabels {
+            title: &title,
+            legend: &legend,
+            y: "f·|cos θ_o| (1/sr)",
+            x: "θ_o (deg), + mirror side, − light's side (plane of incidence)",
+        };
         let (cols, rows) = self.grid();
-        let panels = body.split_evenly((rows, cols));
+        let panels = style::draw_grid(root, &labels, (cols, rows))?;
         for (i, case) in self.cases.iter().enumerate() {
             let (block, col) = (i / cols, i % cols);
             for (r, &slot) in self.slots.iter().enumerate() {

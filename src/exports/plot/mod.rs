@@ -153,13 +153,19 @@ fn pretty_field(column: usize, value: &str) -> String {
 
 /// The fields of `case` that vary over the run, except those of `skip`, for captions.
 fn pretty_fields(run: &RunDir, case: &Case, skip: &[usize]) -> String {
-    let fields = case_fields(case);
-    varying(&run.cases)
-        .into_iter()
-        .filter(|c| !skip.contains(c))
-        .map(|c| pretty_field(c, &fields[c]))
-        .collect::<Vec<_>>()
-        .join(", ")
+    let columns: Vec<usize> = varying(&run.cases).into_iter().filter(|c| !skip.contains(c)).collect();
+    describe(&case_fields(case), &columns).join(", ")
+}
+
+/// How the case columns `columns` of a case (its `fields`) read in captions, an isotropic
+/// roughness as one value.
+fn describe(fields: &[String], columns: &[usize]) -> Vec<String> {
+    let isotropic = columns.contains(&2) && columns.contains(&3) && fields[2] == fields[3];
+    columns
+        .iter()
+        .filter(|&&c| !(isotropic && c == 3))
+        .map(|&c| if isotropic && c == 2 { format!("α = {}", fields[2]) } else { pretty_field(c, &fields[c]) })
+        .collect()
 }
 
 /// A self-contained name of a case's surface and material (NDF, roughness, material, and the

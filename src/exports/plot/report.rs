@@ -9,7 +9,7 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use super::{Drawn, Selection, pretty_field, slot_label, surface_label, varying};
+use super::{Drawn, Selection, describe, pretty_fields, slot_label, surface_label, varying};
 use crate::analysis::stats::sidak;
 use crate::io::output::{CASE_COLUMNS, case_fields};
 use crate::io::rundir::{Lobes, RunDir, Table};
@@ -26,6 +26,11 @@ pub(super) struct Section<'a> {
     pub cases: Vec<&'a Case>,
     pub lobes: Vec<Drawn>,
     pub heats: Vec<Drawn>,
+}
+
+/// A p-value for the tables: `0` where it underflowed, else three significant digits.
+fn p_text(p: f64) -> String {
+    if p == 0.0 { "0".into() } else { format!("{p:.2e}") }
 }
 
 fn escape(text: &str) -> String {
@@ -128,14 +133,14 @@ fn comparison_tables(html: &mut String, run: &RunDir, rows: &[Comparison]) {
             if rejected == 0 { "agrees with the walk".to_string() } else { format!("rejected in {rejected} lobes") };
         let _ = writeln!(
             html,
-            "<tr><td>{}</td><td>{}</td><td>{level:.2e}</td><td>{rejected}</td><td>{worst:.2e}</td><td class=\"{}\">{verdict}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td>{level:.2e}</td><td>{rejected}</td><td>{}</td><td class=\"{}\">{verdict}</td></tr>",
             escape(model),
             lobes.len(),
+            p_text(worst),
             if rejected == 0 { "pass" } else { "fail" }
         );
     }
     html.push_str("</table>\n");
-    let shown = varying(&run.cases);
     for (model, lobes) in &by_model {
         let mut worst: Vec<&&Comparison> = lobes.iter().collect();
         worst.sort_by(|a, b| a.p.total_cmp(&b.p));
@@ -143,8 +148,7 @@ fn comparison_tables(html: &mut String, run: &RunDir, rows: &[Comparison]) {
         html.push_str("<table class=\"compare\"><tr><th>case</th><th>parameters</th><th>order</th><th>hemisphere</th><th>χ²</th><th>dof</th><th>p</th><th>rel L1</th><th>albedo diff (SE)</th></tr>\n");
         for c in worst.into_iter().take(WORST) {
             let case = &run.cases[c.case.min(run.cases.len() - 1)];
-            let fields = case_fields(case);
-            let parameters: Vec<String> = shown.iter().map(|&i| pretty_field(i, &fields[i])).collect();
+            let parameters = pretty_fields(run, case, &[]);
             let order = if c.folded == Some(true) { format!("{}+", c.order) } else { slot_label(run, c.order) };
             let hemisphere = match &c.channel {
                 Some(ch) => format!("{} ({ch})", c.hemisphere),
@@ -152,14 +156,14 @@ fn comparison_tables(html: &mut String, run: &RunDir, rows: &[Comparison]) {
             };
             let _ = writeln!(
                 html,
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td>{:.2e}</td><td>{:.3}</td><td>{:.1}</td></tr>",
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td>{}</td><td>{:.3}</td><td>{:.1}</td></tr>",
                 c.case,
-                escape(&parameters.join(", ")),
+                escape(&parameters),
                 escape(&order),
                 escape(&hemisphere),
                 c.chi2,
                 escape(&c.dof),
-                c.p,
+                p_text(c.p),
                 c.rel_l1,
                 c.albedo_diff_se
             );
@@ -193,8 +197,8 @@ pub(super) fn page(
     // The header line: what every case shares.
     let shown = varying(&run.cases);
     let first = case_fields(&run.cases[0]);
-    let constant: Vec<String> =
-        (1..CASE_COLUMNS.len()).filter(|c| !shown.contains(c)).map(|c| pretty_field(c, &first[c])).collect();
+    let fixed: Vec<usize> = (1..CASE_COLUMNS.len()).filter(|c| !shown.contains(c)).collect();
+    let constant = describe(&first, &fixed);
     let _ = writeln!(
         html,
         "<p class=\"header\">{} cases, {} photons each, seed {}; detector {} × {} bins (|cos θ_o| × φ_o){}. \

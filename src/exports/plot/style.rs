@@ -196,6 +196,42 @@ pub fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, entries: &
     Ok(())
 }
 
+/// Bands around a grid of panels: the title and the legend above, the y label shared by the
+/// grid on the left and the x label below.
+const GRID_TOP: u32 = 78;
+const GRID_LEFT: u32 = 30;
+const GRID_BOTTOM: u32 = 34;
+
+/// What a grid of panels says around them.
+pub struct GridLabels<'a> {
+    pub title: &'a str,
+    pub legend: &'a [(Key, String)],
+    pub y: &'a str,
+    pub x: &'a str,
+}
+
+/// The canvas size of a grid of `cols` x `rows` panels of `panel` pixels with its bands.
+pub fn grid_size(panel: (u32, u32), (cols, rows): (usize, usize)) -> (u32, u32) {
+    (GRID_LEFT + panel.0 * cols as u32, GRID_TOP + panel.1 * rows as u32 + GRID_BOTTOM)
+}
+
+/// Draws the title, the legend and the shared axis labels of a grid of panels, and returns
+/// the panels' areas row by row.
+pub fn draw_grid<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    labels: &GridLabels,
+    (cols, rows): (usize, usize),
+) -> Result<Vec<DrawingArea<DB, Shift>>> {
+    let (width, height) = root.dim_in_pixel();
+    draw_centred(root, labels.title, (width as i32 / 2, 18), TITLE, false)?;
+    draw_legend(&root.margin(38, 0, 0, 0).shrink((0, 0), (width, 36)), labels.legend)?;
+    let middle = (GRID_TOP + (height - GRID_TOP - GRID_BOTTOM) / 2) as i32;
+    draw_centred(root, labels.y, (GRID_LEFT as i32 / 2, middle), LABEL, true)?;
+    let below = ((GRID_LEFT + (width - GRID_LEFT) / 2) as i32, (height - GRID_BOTTOM / 2) as i32);
+    draw_centred(root, labels.x, below, LABEL, false)?;
+    Ok(root.margin(GRID_TOP, GRID_BOTTOM, GRID_LEFT, 0).split_evenly((rows, cols)))
+}
+
 /// Draws a text centred at a pixel, turned by `rotate` (axis labels shared by a row or column
 /// of panels).
 pub fn draw_centred<DB: DrawingBackend>(
@@ -278,7 +314,9 @@ pub fn render(figure: &impl Figure, format: Format) -> Result<Vec<u8>> {
                 figure.draw(&root)?;
                 root.present().map_err(draw_err)?;
             }
-            Ok(svg.into_bytes())
+            // plotters-svg 0.3.7 labels embedded PNGs `data:png`; the MIME type is image/png
+            // (browsers guess it, stricter SVG readers do not).
+            Ok(svg.replace("href=\"data:png;base64,", "href=\"data:image/png;base64,").into_bytes())
         }
     }
 }
