@@ -13,7 +13,8 @@ the same as in `smithwalk plot` (docs/figures.md).
     python3 scripts/plot_lobes.py out/quickstart/lobes.csv --out lobes.png [--orders 1 2 3 0]
 
 With several surfaces, materials or hemispheres, one file each: lobes_g0_R.png, lobes_g1_T.png...
-(the --out name with _g<k>_<R|T> before the extension). --format svg or pdf writes vector files.
+(the --out name with _g<k>_<R|T> before the extension). An --out ending in .svg or .pdf writes
+vector files.
 """
 import argparse
 import math
