@@ -3,12 +3,12 @@
 //! models. docs/figures.md describes every figure and the fixed style of models and orders.
 //!
 //! - `lobes_g<k>_<R|T>`: the plane-of-incidence lobes of one surface and material
-//!   ([`lobes`]);
+//!   (`lobes`);
 //! - `heat_case<i>_<R|T>`: the full lobe f per order over the projected hemisphere
-//!   ([`heatmap`]);
+//!   (`heatmap`);
 //! - `albedo_vs_theta`, `albedo_vs_alpha`: per-order albedos against a swept parameter
-//!   ([`albedo`]);
-//! - `index.html` ([`report`]).
+//!   (`albedo`);
+//! - `index.html` (`report`).
 
 mod albedo;
 mod heatmap;
