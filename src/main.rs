@@ -90,10 +90,22 @@ enum Command {
         threads: Option<usize>,
     },
     /// Draw a run's lobes (plane of incidence per order with the models of models.csv, polar
-    /// heat maps) and per-order albedos as PNG files, with an index.html, into the run directory.
+    /// heat maps) and per-order albedos, with an index.html report, into the run directory.
     Plot {
         /// The run's output directory.
         run_dir: PathBuf,
+        /// Figure format: png, or svg (vector; heat maps embedded as images).
+        #[arg(long, default_value = "png", value_parser = ["png", "svg"])]
+        format: String,
+        /// Directory for the figures and index.html (default: RUN_DIR).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Channel drawn for RGB runs.
+        #[arg(long, default_value = "r", value_parser = ["r", "g", "b"])]
+        channel: String,
+        /// Heat maps on a logarithmic colour scale (three decades below each panel's maximum).
+        #[arg(long)]
+        log: bool,
     },
     /// Export an isotropic reflective sweep (one surface and material, many theta_deg) as a
     /// MERL .binary BRDF file.
@@ -419,8 +431,14 @@ fn main() -> ExitCode {
             smithwalk::analysis::compare::compare(&run_dir, &models, paths, threads).map(|report| print!("{report}"))
         }
         Command::Lut { config, paths, threads, out } => lut(&config, paths, threads, out),
-        Command::Plot { run_dir } => smithwalk::exports::plot::plot(&run_dir)
-            .map(|written| println!("wrote {} files; open {}", written.len(), run_dir.join("index.html").display())),
+        Command::Plot { run_dir, format, out, channel, log } => {
+            use smithwalk::exports::plot::{Format, PlotOptions};
+            let format = if format == "svg" { Format::Svg } else { Format::Png };
+            let channel = ["r", "g", "b"].iter().position(|c| *c == channel).unwrap_or(0);
+            let index = out.clone().unwrap_or_else(|| run_dir.clone()).join("index.html");
+            smithwalk::exports::plot::plot(&run_dir, &PlotOptions { format, out, channel, log })
+                .map(|written| println!("wrote {} files; open {}", written.len(), index.display()))
+        }
         Command::Merl { run_dir, out } => {
             let out = out.unwrap_or_else(|| run_dir.join("brdf.binary"));
             smithwalk::exports::merl::export(&run_dir, &out).map(|p| println!("wrote {}", p.display()))

@@ -1,23 +1,34 @@
-//! `smithwalk plot`: every figure of a run with models is written, decodes as a PNG of the
-//! expected size with more than background in it, and `index.html` links exactly the figures.
+//! `smithwalk plot`: every figure of a run with models is written and decodes with content;
+//! `index.html` shows exactly the figures, each with a caption, the case columns that vary,
+//! and the comparison read from compare.csv by column name; SVG output, `--out`, the channel of
+//! RGB runs, and wide sweeps wrapped into a grid.
 
 use std::collections::BTreeSet;
+use std::path::Path;
 
-use smithwalk::setup::config::Config;
-use smithwalk::setup::config::Model;
+use smithwalk::exports::plot::{Format, PlotOptions, plot};
+use smithwalk::setup::config::{Config, Model};
 
-#[test]
-fn plot_writes_every_figure_and_an_index_that_shows_them() {
-    let toml = "paths = 20000\nseed = 3\n[surface]\nalpha = [0.3, 0.8]\n[[material]]\nkind = \"conductor\"\n[[material]]\nkind = \"dielectric\"\neta = 1.5\n[incident]\ntheta_deg = [0, 45]\n[detector]\ncos_theta_bins = 8\nphi_bins = 16\nmax_order = 3\n";
+fn run(toml: &str, dir: &Path) -> smithwalk::Simulation {
     let config = Config::parse(toml).unwrap();
     let sim = smithwalk::simulate(&config, Some(2), false).unwrap();
+    smithwalk::write_outputs(&sim, &config, dir).unwrap();
+    sim
+}
+
+fn names(written: &[std::path::PathBuf]) -> BTreeSet<String> {
+    written.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect()
+}
+
+const GRID: &str = "paths = 20000\nseed = 3\n[surface]\nalpha = [0.3, 0.8]\n[[material]]\nkind = \"conductor\"\n[[material]]\nkind = \"dielectric\"\neta = 1.5\n[incident]\ntheta_deg = [0, 45]\n[detector]\ncos_theta_bins = 8\nphi_bins = 16\nmax_order = 3\n";
+
+#[test]
+fn plot_writes_every_figure_and_a_report_that_shows_them() {
     let dir = tempfile::tempdir().unwrap();
-    smithwalk::write_outputs(&sim, &config, dir.path()).unwrap();
+    let sim = run(GRID, dir.path());
     smithwalk::analysis::compare::compare(dir.path(), &[Model::Single, Model::WangCorrelated], Some(20000), Some(2))
         .unwrap();
-    let written = smithwalk::exports::plot::plot(dir.path()).unwrap();
-    let names: BTreeSet<String> =
-        written.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    let names = names(&plot(dir.path(), &PlotOptions::default()).unwrap());
 
     // 8 cases: 4 conductor (R) and 4 dielectric (R and T) heat maps; 4 groups of lobes
     // (alpha x material), the dielectric ones in R and T; two albedo figures; the index.
@@ -39,17 +50,113 @@ fn plot_writes_every_figure_and_an_index_that_shows_them() {
 
     for name in names.iter().filter(|n| n.ends_with(".png")) {
         let image = image::open(dir.path().join(name)).unwrap().to_rgb8();
-        assert!(image.width() >= 300 && image.height() >= 250, "{name}: {:?}", image.dimensions());
+        assert!(image.width() >= 600 && image.height() >= 300, "{name}: {:?}", image.dimensions());
         let colours: BTreeSet<[u8; 3]> = image.pixels().map(|p| p.0).collect();
         assert!(colours.len() > 20, "{name}: only {} colours", colours.len());
     }
-    // The lobe figures have 3 order rows + all orders, and a column per incident angle.
+    // 4 order rows (1, 2, 3+, all) by 2 incident angles: taller than wide.
     let lobes = image::open(dir.path().join("lobes_g0_R.png")).unwrap();
-    assert_eq!((lobes.width(), lobes.height()), (2 * 280, 40 + 4 * 210));
+    assert!(lobes.height() > lobes.width(), "{:?}", (lobes.width(), lobes.height()));
 
     let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
     let linked: BTreeSet<String> = html.split('"').filter(|s| s.ends_with(".png")).map(String::from).collect();
     let pngs: BTreeSet<String> = expected.iter().filter(|n| n.ends_with(".png")).cloned().collect();
     assert_eq!(linked, pngs);
-    assert!(html.contains("single, wang-correlated"), "the index names the models");
+    // A caption under every figure.
+    assert_eq!(html.matches("<img ").count(), pngs.len());
+    assert_eq!(html.matches("<figcaption>").count(), pngs.len());
+    // Columns constant over the run go into the header line, not the case tables.
+    assert!(html.contains("ndf ggx") && !html.contains("<th>ndf</th>"), "constant columns in the header");
+    assert!(html.contains("<th>theta_i_deg</th>") && html.contains("<th>alpha_x</th>"));
+    // The comparison: per model its lobes and verdict, and the worst lobes.
+    assert!(html.contains("Models: single, wang-correlated."), "the header names the models");
+    assert!(html.contains("<h2>Measurement against the models</h2>"));
+    for heading in ["single: the 5 lobes with the lowest p", "wang-correlated: the 5 lobes with the lowest p"] {
+        assert!(html.contains(heading), "{heading}");
+    }
+}
+
+/// The comparison table reads compare.csv by column name and shows `family_level` and
+/// `rejected` where compare.csv has them; without them it computes Sidak's level itself.
+#[test]
+fn the_report_takes_family_level_and_rejections_from_compare_csv_when_present() {
+    let dir = tempfile::tempdir().unwrap();
+    run(GRID, dir.path());
+    smithwalk::analysis::compare::compare(dir.path(), &[Model::Single], Some(20000), Some(2)).unwrap();
+    plot(dir.path(), &PlotOptions::default()).unwrap();
+    let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
+    // 8 cases, order 1, R for all and T for the 4 dielectric ones: 12 lobes; Sidak at 0.01.
+    let level = 1.0 - 0.99_f64.powf(1.0 / 12.0);
+    let row = format!("<tr><td>single</td><td>12</td><td>{level:.2e}</td>");
+    assert!(html.contains(&row), "{row} not in the report");
+
+    // The same table with the columns another version of compare writes, in another order.
+    let path = dir.path().join("compare.csv");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut lines = text.lines();
+    let mut out = format!("rejected,family_level,{}\n", lines.next().unwrap());
+    for (i, line) in lines.enumerate() {
+        out.push_str(&format!("{},0.5,{line}\n", i == 3));
+    }
+    std::fs::write(&path, out).unwrap();
+    plot(dir.path(), &PlotOptions::default()).unwrap();
+    let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
+    assert!(html.contains("<tr><td>single</td><td>12</td><td>5.00e-1</td><td>1</td>"), "{html}");
+    assert!(html.contains("rejected in 1 lobes"));
+}
+
+#[test]
+fn svg_output_goes_to_another_directory_with_vector_text() {
+    let dir = tempfile::tempdir().unwrap();
+    run(GRID, dir.path());
+    let out = dir.path().join("figures");
+    let options = PlotOptions { format: Format::Svg, out: Some(out.clone()), ..PlotOptions::default() };
+    let names = names(&plot(dir.path(), &options).unwrap());
+    assert!(names.iter().all(|n| n.ends_with(".svg") || n == "index.html"), "{names:?}");
+    assert!(!dir.path().join("index.html").exists(), "--out leaves the run directory alone");
+    let lobes = std::fs::read_to_string(out.join("lobes_g0_R.svg")).unwrap();
+    assert!(lobes.starts_with("<svg") && lobes.trim_end().ends_with("</svg>"));
+    assert!(lobes.contains("f·|cos θ_o| (1/sr)") && lobes.contains("θ_o (deg), + mirror side"), "axis labels as text");
+    // Heat maps are vector axes around an embedded raster.
+    let heat = std::fs::read_to_string(out.join("heat_case0_R.svg")).unwrap();
+    assert!(heat.contains("data:image/png;base64,") && heat.contains("f (1/sr)"));
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(html.contains("src=\"lobes_g0_R.svg\""));
+}
+
+#[test]
+fn rgb_runs_are_drawn_in_the_channel_asked_for_and_mono_runs_refuse_g_and_b() {
+    let dir = tempfile::tempdir().unwrap();
+    let toml = "paths = 20000\n[surface]\nalpha = 0.5\n[material]\nkind = \"hammon\"\nalbedo = [0.9, 0.5, 0.1]\n[incident]\ntheta_deg = [0, 60]\n[detector]\ncos_theta_bins = 8\nphi_bins = 16\nmax_order = 2\n";
+    run(toml, dir.path());
+    let figure = |channel: usize| {
+        let out = dir.path().join(format!("c{channel}"));
+        plot(dir.path(), &PlotOptions { out: Some(out.clone()), channel, ..PlotOptions::default() }).unwrap();
+        (
+            std::fs::read(out.join("albedo_vs_theta.png")).unwrap(),
+            std::fs::read_to_string(out.join("index.html")).unwrap(),
+        )
+    };
+    let (red, red_html) = figure(0);
+    let (blue, blue_html) = figure(2);
+    assert_ne!(red, blue, "the channels' albedos differ");
+    assert!(red_html.contains("the figures show channel r") && blue_html.contains("the figures show channel b"));
+
+    let mono = tempfile::tempdir().unwrap();
+    run(GRID, mono.path());
+    let err = plot(mono.path(), &PlotOptions { channel: 1, ..PlotOptions::default() }).unwrap_err().to_string();
+    assert!(err.contains("--channel g") && err.contains("one channel"), "{err}");
+    assert!(!mono.path().join("index.html").exists(), "no output after an error");
+}
+
+#[test]
+fn a_wide_sweep_wraps_into_a_grid_of_panels() {
+    let dir = tempfile::tempdir().unwrap();
+    let toml = "paths = 5000\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = [0, 9, 18, 27, 36, 45, 54, 63, 72, 81]\n[detector]\ncos_theta_bins = 8\nphi_bins = 16\nmax_order = 1\n";
+    run(toml, dir.path());
+    plot(dir.path(), &PlotOptions::default()).unwrap();
+    // 10 angles x (order 1, all): two blocks of 5 columns, 4 rows, instead of one strip of 10.
+    let lobes = image::open(dir.path().join("lobes_g0_R.png")).unwrap();
+    let (w, h) = (lobes.width() as f64, lobes.height() as f64);
+    assert!(w < 1800.0 && h / w > 0.6, "{w} x {h}");
 }

@@ -1,0 +1,175 @@
+//! The plane-of-incidence figure of one surface and material: f |cos theta_o| (a bin's energy
+//! over its solid angle, theory.md §4.7) against the signed outgoing angle, one row per bounce
+//! order and one column per incident angle, as in the Wang et al. 2022 supplement; sweeps of
+//! more than five angles wrap into blocks of at most five columns.
+
+use std::collections::BTreeMap;
+
+use anyhow::Result;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::style::{self, CAPTION, FONT, Figure, Key, MEASURED, TICK, draw_err};
+use super::{Points, Selection, plane_of_incidence, slot_label, surface_label};
+use crate::io::rundir::{Lobes, RunDir};
+use crate::setup::cases::Case;
+
+const PANEL: (u32, u32) = (330, 250);
+/// The most incident angles side by side before a sweep wraps into another block of rows.
+const MAX_COLUMNS: usize = 5;
+
+pub struct LobeFigure<'a> {
+    pub run: &'a RunDir,
+    pub cases: &'a [&'a Case],
+    pub hemisphere: &'a str,
+    pub selection: Selection,
+    pub measured: &'a Lobes,
+    pub models: &'a BTreeMap<String, Lobes>,
+    pub slots: &'a [usize],
+}
+
+/// Columns per block and blocks for `n` incident angles: as few blocks as possible of at
+/// most [`MAX_COLUMNS`], balanced (10 angles: 2 blocks of 5; 6 angles: 2 of 3).
+pub fn wrap(n: usize) -> (usize, usize) {
+    let blocks = n.div_ceil(MAX_COLUMNS).max(1);
+    (n.div_ceil(blocks).max(1), blocks)
+}
+
+impl LobeFigure<'_> {
+    fn models_drawn(&self) -> Vec<&String> {
+        let ch = self.selection.channel;
+        self.models
+            .iter()
+            .filter(|(_, lobes)| {
+                self.cases
+                    .iter()
+                    .any(|c| self.slots.iter().any(|&s| lobes.get(c.index, s, self.hemisphere, ch).is_some()))
+            })
+            .map(|(name, _)| name)
+            .collect()
+    }
+
+    fn panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, case: &Case, slot: usize) -> Result<()> {
+        let ch = self.selection.channel;
+        let Some(bins) = self.measured.get(case.index, slot, self.hemisphere, ch) else { return Ok(()) };
+        let points = plane_of_incidence(self.run, bins);
+        let lines: Vec<(style::LineStyle, Points)> = self
+            .models
+            .iter()
+            .filter_map(|(name, lobes)| {
+                lobes
+                    .get(case.index, slot, self.hemisphere, ch)
+                    .map(|b| (style::model_style_by_name(name), plane_of_incidence(self.run, b)))
+            })
+            .collect();
+        let top = points
+            .iter()
+            .map(|p| p.1 + p.2)
+            .chain(lines.iter().flat_map(|(_, l)| l.iter().map(|p| p.1)))
+            .fold(0.0_f64, f64::max);
+        let top = if top > 0.0 && top.is_finite() { 1.08 * top } else { 1.0 };
+        let decimals = style::tick_decimals(0.0, top, 5);
+        let caption = format!("{}, θ_i = {:.1}°", slot_label(self.run, slot), case.theta_i_deg);
+        let mut chart = ChartBuilder::on(area)
+            .caption(caption, (FONT, CAPTION))
+            .margin(6)
+            .margin_right(14)
+            .x_label_area_size(26)
+            .y_label_area_size(56)
+            .build_cartesian_2d((-90.0..90.001).step(30.0), 0.0..top)
+            .map_err(draw_err)?;
+        chart
+            .configure_mesh()
+            .light_line_style(TRANSPARENT)
+            .bold_line_style(RGBColor(0xe4, 0xe4, 0xe4))
+            .x_labels(7)
+            .y_labels(5)
+            .label_style((FONT, TICK))
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| style::tick(*v, decimals))
+            .draw()
+            .map_err(draw_err)?;
+        for (line, curve) in &lines {
+            let curve: Vec<(f64, f64)> = curve.iter().map(|p| (p.0, p.1)).collect();
+            style::draw_line(chart.plotting_area(), &curve, *line)?;
+        }
+        chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|&(x, y, e)| PathElement::new(vec![(x, y - e), (x, y + e)], MEASURED.stroke_width(1))),
+            )
+            .map_err(draw_err)?;
+        chart
+            .draw_series(points.iter().map(|&(x, y, _)| Circle::new((x, y), 2, MEASURED.filled())))
+            .map_err(draw_err)?;
+        Ok(())
+    }
+
+    /// What the report says under the figure.
+    pub fn caption(&self) -> String {
+        let g = self.run.grid;
+        let hemisphere = if self.hemisphere == "T" { "transmitted" } else { "reflected" };
+        let models = if self.models_drawn().is_empty() {
+            "No models (run `smithwalk compare` to draw them).".to_string()
+        } else {
+            "Lines: the models of models.csv, each in its fixed colour and dash (docs/figures.md).".to_string()
+        };
+        format!(
+            "{}: the {hemisphere} lobe f·|cos θ_o| (1/sr) in the plane of incidence against the outgoing angle θ_o \
+             (positive on the mirror side, φ_o = 180°; negative on the light's side, φ_o = 0°), one row per bounce \
+             order and one column per incident angle θ_i. Black points: the random walk, each the average over a \
+             detector bin ({} bins in |cos θ_o|, {:.1}° of azimuth), with ±1 standard-error bars. {models}{}",
+            surface_label(self.cases[0]),
+            g.cos_bins,
+            360.0 / g.phi_bins as f64,
+            self.selection.note(),
+        )
+    }
+
+    fn grid(&self) -> (usize, usize) {
+        let (cols, blocks) = wrap(self.cases.len());
+        (cols, blocks * self.slots.len())
+    }
+}
+
+impl Figure for LobeFigure<'_> {
+    fn size(&self) -> (u32, u32) {
+        style::grid_size(PANEL, self.grid())
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
+        let hemisphere = if self.hemisphere == "T" { "transmission (T)" } else { "reflection (R)" };
+        let title = format!("{}: {hemisphere}{}", surface_label(self.cases[0]), self.selection.suffix());
+        let mut legend = vec![(Key::Measured, "random walk (±1 SE)".to_string())];
+        legend.extend(self.models_drawn().into_iter().map(|m| (Key::Line(style::model_style_by_name(m)), m.clone())));
+        let labels = style::GridLabels {
+            title: &title,
+            legend: &legend,
+            y: "f·|cos θ_o| (1/sr)",
+            x: "θ_o (deg), + mirror side, − light's side (plane of incidence)",
+        };
+        let (cols, rows) = self.grid();
+        let panels = style::draw_grid(root, &labels, (cols, rows))?;
+        for (i, case) in self.cases.iter().enumerate() {
+            let (block, col) = (i / cols, i % cols);
+            for (r, &slot) in self.slots.iter().enumerate() {
+                let row = block * self.slots.len() + r;
+                self.panel(&panels[row * cols + col], case, slot)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn wide_sweeps_wrap_into_balanced_blocks() {
+        assert_eq!(super::wrap(4), (4, 1));
+        assert_eq!(super::wrap(5), (5, 1));
+        assert_eq!(super::wrap(6), (3, 2));
+        assert_eq!(super::wrap(10), (5, 2));
+        assert_eq!(super::wrap(11), (4, 3));
+    }
+}

@@ -1,0 +1,353 @@
+//! The figures' fixed style, the same in every figure (docs/figures.md lists it): one colour
+//! and line style per model and per bounce order, the fonts, plain tick labels, legends drawn
+//! outside the data, and the canvas written as PNG or SVG.
+
+use anyhow::{Context, Result, anyhow};
+use plotters::coord::ranged1d::Ranged;
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::{CoordTranslate, Shift};
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+use plotters::style::{FontTransform, text_anchor};
+
+use crate::setup::config::Model;
+
+pub const FONT: &str = "sans-serif";
+/// Text sizes in pixels, chosen so that a figure scaled to a 1000-pixel-wide page keeps its
+/// tick labels at 10 pixels or more.
+pub const TITLE: u32 = 22;
+pub const CAPTION: u32 = 16;
+pub const LABEL: u32 = 17;
+pub const TICK: u32 = 14;
+
+/// The measurement: black points with one-standard-error bars.
+pub const MEASURED: RGBColor = BLACK;
+
+/// How a line is stroked (dashes as (dash, gap) in pixels).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dash {
+    Solid,
+    Dashed,
+    Dotted,
+    LongDash,
+}
+
+impl Dash {
+    fn pattern(self) -> Option<(u32, u32)> {
+        match self {
+            Dash::Solid => None,
+            Dash::Dashed => Some((7, 4)),
+            Dash::Dotted => Some((2, 3)),
+            Dash::LongDash => Some((14, 4)),
+        }
+    }
+}
+
+/// A series' colour, dash and marker, fixed per model and per order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LineStyle {
+    pub colour: RGBColor,
+    pub dash: Dash,
+    pub width: u32,
+    pub marker: Marker,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Marker {
+    None,
+    Circle,
+    Square,
+    Triangle,
+    Diamond,
+    Cross,
+}
+
+/// Okabe and Ito's colour-blind-safe palette, plus a wine red.
+const BLUE: RGBColor = RGBColor(0x00, 0x72, 0xb2);
+const ORANGE: RGBColor = RGBColor(0xe6, 0x9f, 0x00);
+const GREEN: RGBColor = RGBColor(0x00, 0x9e, 0x73);
+const VERMILLION: RGBColor = RGBColor(0xd5, 0x5e, 0x00);
+const PURPLE: RGBColor = RGBColor(0xcc, 0x79, 0xa7);
+const WINE: RGBColor = RGBColor(0x88, 0x22, 0x55);
+const GREY: RGBColor = RGBColor(0x77, 0x77, 0x77);
+
+const fn line(colour: RGBColor, dash: Dash) -> LineStyle {
+    LineStyle { colour, dash, width: 2, marker: Marker::None }
+}
+
+/// The style of a model's lines in every figure.
+pub fn model_style(model: Model) -> LineStyle {
+    match model {
+        Model::Single => line(GREEN, Dash::Solid),
+        Model::HammonFit => line(WINE, Dash::Solid),
+        Model::HeitzNee => line(BLUE, Dash::Dashed),
+        Model::ExactPositionFree => line(VERMILLION, Dash::LongDash),
+        Model::WangCorrelated => line(ORANGE, Dash::Solid),
+        Model::WangUncorrelated => line(PURPLE, Dash::Dotted),
+    }
+}
+
+/// The style of a model named in `models.csv` (grey for a name this version does not know).
+pub fn model_style_by_name(name: &str) -> LineStyle {
+    Model::parse(name).map_or(line(GREY, Dash::Solid), model_style)
+}
+
+/// The style of an order slot (0 = all orders; `4` is also the "4+" slot) in the albedo
+/// figures: a colour, a dash and a marker each, so that the orders stay apart in grey print.
+pub fn order_style(slot: usize) -> LineStyle {
+    let (colour, dash, marker) = match slot {
+        0 => (BLACK, Dash::Solid, Marker::Circle),
+        1 => (BLUE, Dash::Solid, Marker::Square),
+        2 => (ORANGE, Dash::Dashed, Marker::Triangle),
+        3 => (GREEN, Dash::Dotted, Marker::Diamond),
+        _ => (PURPLE, Dash::LongDash, Marker::Cross),
+    };
+    LineStyle { colour, dash, width: 2, marker }
+}
+
+/// A drawing error as an error of this crate.
+pub fn draw_err<E: std::fmt::Display>(e: E) -> anyhow::Error {
+    anyhow!("cannot draw: {e}")
+}
+
+/// Draws a polyline (in the area's coordinates) with the style's dash.
+pub fn draw_line<DB: DrawingBackend, CT: CoordTranslate>(
+    area: &DrawingArea<DB, CT>,
+    points: &[CT::From],
+    style: LineStyle,
+) -> Result<()>
+where
+    CT::From: Clone,
+{
+    let stroke = style.colour.stroke_width(style.width);
+    match style.dash.pattern() {
+        None => area.draw(&PathElement::new(points.to_vec(), stroke)).map_err(draw_err),
+        Some((dash, gap)) => {
+            area.draw(&DashedPathElement::new(points.iter().cloned(), dash, gap, stroke)).map_err(draw_err)
+        }
+    }
+}
+
+/// Draws the style's marker centred on a point (in the area's coordinates).
+pub fn draw_marker<DB: DrawingBackend, CT: CoordTranslate>(
+    area: &DrawingArea<DB, CT>,
+    at: CT::From,
+    style: LineStyle,
+) -> Result<()> {
+    let fill = style.colour.filled();
+    let stroke = style.colour.stroke_width(2);
+    let r = 4;
+    let here = EmptyElement::at(at);
+    match style.marker {
+        Marker::None => Ok(()),
+        Marker::Circle => area.draw(&(here + Circle::new((0, 0), r, fill))),
+        Marker::Square => area.draw(&(here + Rectangle::new([(-r, -r), (r, r)], fill))),
+        Marker::Triangle => area.draw(&(here + Polygon::new(vec![(0, -r - 1), (-r - 1, r), (r + 1, r)], fill))),
+        Marker::Diamond => area.draw(&(here + Polygon::new(vec![(0, -r - 1), (r, 0), (0, r + 1), (-r, 0)], fill))),
+        Marker::Cross => area.draw(
+            &(here
+                + PathElement::new(vec![(-r, -r), (r, r)], stroke)
+                + PathElement::new(vec![(-r, r), (r, -r)], stroke)),
+        ),
+    }
+    .map_err(draw_err)
+}
+
+/// A legend entry: a line sample (and marker), or the measurement's point with an error bar.
+pub enum Key {
+    Line(LineStyle),
+    Measured,
+}
+
+/// Draws a one-line legend centred in `area` (a band outside the panels), entries left to
+/// right.
+pub fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, entries: &[(Key, String)]) -> Result<()> {
+    let font = (FONT, CAPTION).into_font();
+    let sample = 34;
+    let widths: Vec<i32> = entries
+        .iter()
+        .map(|(_, name)| {
+            let (w, _) =
+                area.estimate_text_size(name, &TextStyle::from(font.clone())).unwrap_or((8 * name.len() as u32, 0));
+            sample + 6 + w as i32 + 24
+        })
+        .collect();
+    let (width, height) = area.dim_in_pixel();
+    let mut x = ((width as i32 - widths.iter().sum::<i32>()) / 2).max(4);
+    let y = height as i32 / 2;
+    for ((key, name), w) in entries.iter().zip(&widths) {
+        match key {
+            Key::Line(style) => {
+                draw_line(area, &[(x, y), (x + sample, y)], *style)?;
+                draw_marker(area, (x + sample / 2, y), *style)?;
+            }
+            Key::Measured => {
+                let c = (x + sample / 2, y);
+                area.draw(&PathElement::new(vec![(c.0, y - 8), (c.0, y + 8)], MEASURED.stroke_width(1)))
+                    .map_err(draw_err)?;
+                area.draw(&Circle::new(c, 3, MEASURED.filled())).map_err(draw_err)?;
+            }
+        }
+        let style =
+            font.clone().color(&BLACK).pos(text_anchor::Pos::new(text_anchor::HPos::Left, text_anchor::VPos::Center));
+        area.draw(&Text::new(name.clone(), (x + sample + 6, y), style)).map_err(draw_err)?;
+        x += w;
+    }
+    Ok(())
+}
+
+/// Bands around a grid of panels: the title and the legend above, the y label shared by the
+/// grid on the left and the x label below.
+const GRID_TOP: u32 = 78;
+const GRID_LEFT: u32 = 30;
+const GRID_BOTTOM: u32 = 34;
+
+/// What a grid of panels says around them.
+pub struct GridLabels<'a> {
+    pub title: &'a str,
+    pub legend: &'a [(Key, String)],
+    pub y: &'a str,
+    pub x: &'a str,
+}
+
+/// The canvas size of a grid of `cols` x `rows` panels of `panel` pixels with its bands.
+pub fn grid_size(panel: (u32, u32), (cols, rows): (usize, usize)) -> (u32, u32) {
+    (GRID_LEFT + panel.0 * cols as u32, GRID_TOP + panel.1 * rows as u32 + GRID_BOTTOM)
+}
+
+/// Draws the title, the legend and the shared axis labels of a grid of panels, and returns
+/// the panels' areas row by row.
+pub fn draw_grid<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    labels: &GridLabels,
+    (cols, rows): (usize, usize),
+) -> Result<Vec<DrawingArea<DB, Shift>>> {
+    let (width, height) = root.dim_in_pixel();
+    draw_centred(root, labels.title, (width as i32 / 2, 18), TITLE, false)?;
+    draw_legend(&root.margin(38, 0, 0, 0).shrink((0, 0), (width, 36)), labels.legend)?;
+    let middle = (GRID_TOP + (height - GRID_TOP - GRID_BOTTOM) / 2) as i32;
+    draw_centred(root, labels.y, (GRID_LEFT as i32 / 2, middle), LABEL, true)?;
+    let below = ((GRID_LEFT + (width - GRID_LEFT) / 2) as i32, (height - GRID_BOTTOM / 2) as i32);
+    draw_centred(root, labels.x, below, LABEL, false)?;
+    Ok(root.margin(GRID_TOP, GRID_BOTTOM, GRID_LEFT, 0).split_evenly((rows, cols)))
+}
+
+/// Draws a text centred at a pixel, turned by `rotate` (axis labels shared by a row or column
+/// of panels).
+pub fn draw_centred<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    at: (i32, i32),
+    size: u32,
+    rotate: bool,
+) -> Result<()> {
+    let font = (FONT, size).into_font();
+    let font = if rotate { font.transform(FontTransform::Rotate270) } else { font };
+    let style = font.color(&BLACK).pos(text_anchor::Pos::new(text_anchor::HPos::Center, text_anchor::VPos::Center));
+    area.draw(&Text::new(text.to_string(), at, style)).map_err(draw_err)
+}
+
+/// The number of decimals that writes every tick of the axis `lo..hi` (about `n` ticks, as
+/// plotters places them) exactly, so that all ticks of an axis share one plain format.
+pub fn tick_decimals(lo: f64, hi: f64, n: usize) -> usize {
+    let keys = RangedCoordf64::from(lo..hi).key_points(n);
+    keys.iter()
+        .map(|&v| {
+            (0..=8)
+                .find(|&d| (format!("{v:.d$}").parse::<f64>().unwrap_or(f64::NAN) - v).abs() <= 1e-9 * (hi - lo).abs())
+                .unwrap_or(8)
+        })
+        .max()
+        .unwrap_or(0)
+}
+
+/// A tick label: the value in plain decimal notation with `decimals` places (and `0` for zero).
+pub fn tick(v: f64, decimals: usize) -> String {
+    if v.abs() < 1e-12 { "0".into() } else { format!("{v:.decimals$}") }
+}
+
+/// What a figure needs to be drawn on any plotters backend.
+pub trait Figure {
+    /// Canvas size in pixels.
+    fn size(&self) -> (u32, u32);
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>;
+}
+
+/// Output format of the figures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    Png,
+    Svg,
+}
+
+impl Format {
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Png => "png",
+            Format::Svg => "svg",
+        }
+    }
+}
+
+/// Draws a figure on a white canvas and encodes it.
+pub fn render(figure: &impl Figure, format: Format) -> Result<Vec<u8>> {
+    let (width, height) = figure.size();
+    match format {
+        Format::Png => {
+            let mut pixels = vec![0u8; (width * height * 3) as usize];
+            {
+                let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
+                root.fill(&WHITE).map_err(draw_err)?;
+                figure.draw(&root)?;
+                root.present().map_err(draw_err)?;
+            }
+            let image = image::RgbImage::from_raw(width, height, pixels).context("canvas size")?;
+            let mut png = std::io::Cursor::new(Vec::new());
+            image.write_to(&mut png, image::ImageOutputFormat::Png).context("cannot encode PNG")?;
+            Ok(png.into_inner())
+        }
+        Format::Svg => {
+            let mut svg = String::new();
+            {
+                let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+                root.fill(&WHITE).map_err(draw_err)?;
+                figure.draw(&root)?;
+                root.present().map_err(draw_err)?;
+            }
+            // plotters-svg 0.3.7 labels embedded PNGs `data:png`; the MIME type is image/png
+            // (browsers guess it, stricter SVG readers do not).
+            Ok(svg.replace("href=\"data:png;base64,", "href=\"data:image/png;base64,").into_bytes())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_model_and_order_has_its_own_style() {
+        let models: Vec<LineStyle> = Model::ALL.iter().map(|&m| model_style(m)).collect();
+        for (i, a) in models.iter().enumerate() {
+            for b in &models[i + 1..] {
+                assert_ne!(a.colour, b.colour);
+            }
+        }
+        let orders: Vec<LineStyle> = [0, 1, 2, 3, 4].map(order_style).to_vec();
+        for (i, a) in orders.iter().enumerate() {
+            for b in &orders[i + 1..] {
+                assert!(a.colour != b.colour && a.marker != b.marker);
+            }
+        }
+        assert_eq!(model_style_by_name("heitz-nee"), model_style(Model::HeitzNee));
+    }
+
+    #[test]
+    fn ticks_are_plain_decimals_with_one_format_per_axis() {
+        assert_eq!(tick_decimals(0.0, 0.33, 5), 1);
+        assert_eq!(tick(0.3, 1), "0.3");
+        assert_eq!(tick(0.0, 3), "0");
+        assert_eq!(tick_decimals(-90.0, 90.0, 7), 0);
+        assert!(tick_decimals(0.0, 0.0033, 5) >= 3);
+    }
+}
