@@ -26,7 +26,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use microsurface::wang::Shadowing;
 
 use crate::analysis::models::{
-    HammonFitPart, LobeIntegrals, MAX_BIN_EVALUATIONS, hammon_fit_lobe_bins, single_scattering_lobe,
+    HammonFitPart, LobeIntegrals, MAX_BIN_EVALUATIONS, MAX_EXIT_BIN_EVALUATIONS, hammon_fit_lobe_bins,
+    single_scattering_lobe,
 };
 use crate::analysis::stats::{self, ChiSquare, WeightedBin};
 use crate::atomic::write_atomically;
@@ -441,10 +442,11 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
             notes.push((
                 model,
                 format!(
-                    "the quadrature stopped at its bound of {MAX_BIN_EVALUATIONS} evaluations in {} bins \
-                     (largest error estimate there: {:.2} of the bin's tolerance, {QUADRATURE_FRACTION} standard \
-                     error)",
-                    predictions.capped, predictions.worst_capped
+                    "the quadrature stopped at its evaluation bound ({MAX_BIN_EVALUATIONS} per bin, \
+                     {MAX_EXIT_BIN_EVALUATIONS} for exit lobes) in {} bins; largest error estimate there: {:.2} \
+                     standard errors of the bin",
+                    predictions.capped,
+                    predictions.worst_capped * QUADRATURE_FRACTION
                 ),
             ));
         }
@@ -685,8 +687,9 @@ fn report(
     if !approximations.is_empty() {
         let _ = writeln!(
             out,
-            "({} approximate the walk: their rejections measure the approximation, not a fault)",
-            approximations.join(", ")
+            "({} {} the walk: rejections measure the approximation, not a fault)",
+            approximations.join(", "),
+            if approximations.len() == 1 { "approximates" } else { "approximate" }
         );
     }
     out
