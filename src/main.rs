@@ -88,6 +88,14 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
+        /// Family-wise level of each model's verdict: its lobes are judged at the Sidak level
+        /// that keeps the chance of any false rejection among them at this value.
+        #[arg(long, default_value_t = smithwalk::analysis::compare::DEFAULT_FAMILY_LEVEL)]
+        level: f64,
+        /// Exit with status 3 when an exact oracle (single, heitz-nee, exact-position-free)
+        /// rejects a lobe, to gate code on it in CI (exit status 1 is an error).
+        #[arg(long)]
+        fail_on_reject: bool,
     },
     /// Draw a run's lobes (plane of incidence per order with the models of models.csv, polar
     /// heat maps) and per-order albedos, with an index.html report, into the run directory.
@@ -427,8 +435,21 @@ fn main() -> ExitCode {
             run(RunArgs { config, paths, seed, threads, out, shard, resume, checkpoint_seconds })
         }
         Command::Merge { shards, out } => merge(&shards, &out),
-        Command::Compare { run_dir, models, paths, threads } => {
-            smithwalk::analysis::compare::compare(&run_dir, &models, paths, threads).map(|report| print!("{report}"))
+        Command::Compare { run_dir, models, paths, threads, level, fail_on_reject } => {
+            let options = smithwalk::analysis::compare::CompareOptions {
+                family_level: level,
+                ..smithwalk::analysis::compare::CompareOptions::new(models, paths, threads)
+            };
+            match smithwalk::analysis::compare::compare_with(&run_dir, &options) {
+                Ok(outcome) => {
+                    print!("{}", outcome.report);
+                    if fail_on_reject && outcome.exact_oracle_rejected() {
+                        return ExitCode::from(3);
+                    }
+                    Ok(())
+                }
+                Err(e) => Err(e),
+            }
         }
         Command::Lut { config, paths, threads, out } => lut(&config, paths, threads, out),
         Command::Plot { run_dir, format, out, channel, log } => {

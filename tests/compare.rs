@@ -38,7 +38,7 @@ fn a_run_with_a_compare_section_measures_the_models() {
         .unwrap();
     assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
     let stdout = String::from_utf8_lossy(&result.stdout);
-    assert!(stdout.contains("single (12 lobes)") && stdout.contains("wang-correlated"), "{stdout}");
+    assert!(stdout.contains("single (exact oracle): 12 lobes") && stdout.contains("wang-correlated"), "{stdout}");
     assert!(out.join("models.csv").is_file());
     let mut reader = csv::Reader::from_path(out.join("compare.csv")).unwrap();
     let headers = reader.headers().unwrap().clone();

@@ -1,213 +1,147 @@
-//! `smithwalk compare`: a run's measured lobes against analytic models in the same bins, per
-//! case, order and hemisphere (docs/theory.md §4.7, §9.5).
+//! `smithwalk compare`: a run's measured lobes against models in the same bins, per case, order
+//! and hemisphere, with a verdict per model (docs/theory.md §4.7, §9.5; docs/compare.md).
 //!
 //! Models: `single` (exact single scattering by quadrature, order 1, every facet material with
-//! the true Smith Lambda and visible normals), `heitz-nee` (next-event
-//! estimation along the walk, every order), `wang-correlated` and `wang-uncorrelated` (the
-//! Wang et al. 2022 chains), `exact-position-free` (the walk with its depths integrated out,
-//! §7.1, for one-sided facets); the Monte Carlo models run into the same detector with their own
-//! standard errors. `hammon-fit` is Hammon 2017's closed-form approximation for his facet
-//! (order 1 and all orders), integrated over the bins by quadrature.
+//! the true Smith Lambda and visible normals), `heitz-nee` (next-event estimation along the
+//! walk, every order), `exact-position-free` (the walk with its depths integrated out, §7.1, for
+//! one-sided facets): these three are exact for the Smith walk, so a rejection says the
+//! measurement (or the oracle) is wrong. `wang-correlated` and `wang-uncorrelated` (the Wang et
+//! al. 2022 chains) and `hammon-fit` (Hammon 2017's closed-form fit of his facet, order 1 and all
+//! orders) are approximations: their rejections measure how far they are from the walk. The
+//! Monte Carlo models run into the same detector with their own standard errors.
+//!
+//! Like with like: the run's last order slot "K+" (`max_order = K`) holds every order from K
+//! on; a Monte Carlo model is walked with the same `max_order`, so its slots are folded exactly
+//! as the run's; `hammon-fit` folds its order-1 part into its all-orders part for a "1+" slot;
+//! `single`, order 1 alone, is never tested against a "1+" slot. With `max_order = 1` the "1+"
+//! slot is the all-orders lobe, which is tested once, as order 0.
 
-use std::collections::HashMap;
 use std::fmt::Write as _;
+use std::io::IsTerminal as _;
 use std::path::Path;
+use std::time::Instant;
 
-use anyhow::Result;
+use anyhow::{Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
 use microsurface::wang::Shadowing;
 
-use crate::analysis::models::{HammonFitPart, hammon_fit_bins, single_scattering_bins};
+use crate::analysis::models::{
+    HammonFitPart, LobeIntegrals, MAX_BIN_EVALUATIONS, MAX_EXIT_BIN_EVALUATIONS, hammon_fit_lobe_bins,
+    single_scattering_lobe,
+};
 use crate::analysis::stats::{self, ChiSquare, WeightedBin};
 use crate::atomic::write_atomically;
-use crate::engine::detector::{Grid, Hemisphere};
-use crate::engine::run::{Estimator, Shard};
+use crate::engine::detector::{Detector, Grid, Hemisphere};
+use crate::engine::run::{CaseResult, Estimator, Shard};
 use crate::engine::{RunOptions, Simulation};
-use crate::io::output::case_fields;
-use crate::io::rundir::{Table, read_config};
+use crate::io::output::{CASE_COLUMNS, case_fields, hemisphere_sign, hemispheres};
+use crate::io::rundir::{BinValue, LobeId, Lobes, RunDir};
+use crate::setup::cases::Case;
 use crate::setup::config::{Config, Model};
 
 /// Outgoing directions per hit of the next-event estimator.
 const NEE_DIRECTIONS: u32 = 4;
 
-/// A bin's value and standard error.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct Value {
-    energy: f64,
-    stderr: f64,
+/// The family-wise level at which each model's lobes are judged unless `--level` says otherwise.
+pub const DEFAULT_FAMILY_LEVEL: f64 = 0.01;
+
+/// The quadrature tolerance of a bin of a closed-form model, as a fraction of the measured
+/// bin's standard error (at least of one photon's energy, `1/N`, for an empty bin): a bias of
+/// 0.05 standard errors moves a bin's expected chi-square by 0.0025, far below its spread.
+const QUADRATURE_FRACTION: f64 = 0.05;
+
+/// Bins of a lobe with less than this many photons' worth of energy are pooled (§9.5).
+const MIN_COUNT: f64 = 5.0;
+
+/// What `smithwalk compare` is asked to do.
+#[derive(Clone, Debug)]
+pub struct CompareOptions {
+    pub models: Vec<Model>,
+    /// Photons per case for the Monte Carlo models (default: the run's).
+    pub paths: Option<u64>,
+    pub threads: Option<usize>,
+    /// The family-wise level of each model's verdict (Sidak over its lobes).
+    pub family_level: f64,
 }
 
-/// Key of one bin row: case, order, hemisphere, channel, cos_lo, phi_lo (as written).
-type BinKey = (String, String, String, String, String, String);
-/// Key of one lobe: case, order, hemisphere, channel.
-type LobeKey = (String, String, String, String);
-
-/// The lobe key of every record: case, order, hemisphere, channel ("" for mono runs).
-fn lobe_keys(table: &Table) -> Result<Vec<LobeKey>> {
-    let (case, order, hemi) = (table.column("case")?, table.column("order")?, table.column("hemisphere")?);
-    let channel = table.headers.iter().position(|h| h == "channel");
-    Ok(table
-        .records
-        .iter()
-        .map(|r| {
-            let channel = channel.map_or(String::new(), |c| r[c].to_string());
-            (r[case].to_string(), r[order].to_string(), r[hemi].to_string(), channel)
-        })
-        .collect())
-}
-
-/// The measured bins of a run directory's `lobes.csv`.
-fn read_lobes(path: &Path) -> Result<HashMap<BinKey, Value>> {
-    let table = Table::read(path)?;
-    let (cos_lo, phi_lo) = (table.column("cos_lo")?, table.column("phi_lo_deg")?);
-    let (energy, se) = (table.column("energy")?, table.column("energy_stderr")?);
-    let mut out = HashMap::new();
-    for ((case, order, hemi, channel), r) in lobe_keys(&table)?.into_iter().zip(&table.records) {
-        let key = (case, order, hemi, channel, r[cos_lo].to_string(), r[phi_lo].to_string());
-        out.insert(key, Value { energy: r[energy].parse()?, stderr: r[se].parse()? });
+impl CompareOptions {
+    pub fn new(models: Vec<Model>, paths: Option<u64>, threads: Option<usize>) -> Self {
+        Self { models, paths, threads, family_level: DEFAULT_FAMILY_LEVEL }
     }
-    Ok(out)
+
+    fn validate(&self) -> Result<()> {
+        if let Some(p) = self.paths
+            && p < 2
+        {
+            bail!("`--paths` = {p} is not allowed: at least 2 photons per case for the Monte Carlo models");
+        }
+        if self.threads == Some(0) {
+            bail!("`--threads` = 0 is not allowed: at least 1 thread");
+        }
+        if !(self.family_level > 0.0 && self.family_level < 1.0) {
+            bail!("`--level` = {} is not allowed: a family-wise level in (0, 1), such as 0.01", self.family_level);
+        }
+        Ok(())
+    }
 }
 
-/// The measured albedos of a run directory's `summary.csv`, per lobe.
-fn read_summary(path: &Path) -> Result<HashMap<LobeKey, Value>> {
-    let table = Table::read(path)?;
-    let (albedo, se) = (table.column("albedo")?, table.column("albedo_stderr")?);
-    let mut out = HashMap::new();
-    for (key, r) in lobe_keys(&table)?.into_iter().zip(&table.records) {
-        out.insert(key, Value { energy: r[albedo].parse()?, stderr: r[se].parse()? });
-    }
-    Ok(out)
+/// Whether a model is exact for the Smith walk, so that its rejection is a failure (of the
+/// measurement or of the model's code) rather than a measure of an approximation.
+pub fn is_exact_oracle(model: Model) -> bool {
+    matches!(model, Model::Single | Model::HeitzNee | Model::ExactPositionFree)
 }
 
-/// One model's prediction of one bin.
-struct Prediction {
-    key: BinKey,
-    fields: Vec<String>,
-    value: Value,
-    solid_angle: f64,
-    bounds: [f64; 4],
+/// One model's verdict on a run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Verdict {
+    pub model: Model,
+    /// Lobes tested (the family).
+    pub lobes: usize,
+    /// Lobes whose p-value is below the Sidak per-lobe level.
+    pub rejected: usize,
+    /// Why the model was not compared at all, if it was not.
+    pub skipped: Option<String>,
 }
 
-/// The model's predictions for every bin of every case it applies to.
-fn predict(
-    model: Model,
-    config: &Config,
-    sim_photons: u64,
-    seed: u64,
-    threads: Option<usize>,
-) -> Result<Vec<Prediction>> {
-    let grid = Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins };
-    let cases = crate::setup::cases::expand(config);
-    let mut out = Vec::new();
-    let rows = |case: &crate::setup::cases::Case,
-                order: usize,
-                hemisphere: Hemisphere,
-                channel: &str,
-                values: &mut dyn FnMut(usize) -> Value,
-                out: &mut Vec<Prediction>| {
-        let sign = crate::io::output::hemisphere_sign(case.side, hemisphere);
-        for ic in 0..grid.cos_bins {
-            let (lo, hi) = grid.cos_edges(ic);
-            let (cos_lo, cos_hi) = if sign > 0.0 { (lo, hi) } else { (-hi, -lo) };
-            for ip in 0..grid.phi_bins {
-                let (phi_lo, phi_hi) = grid.phi_edges_deg(ip);
-                let key = (
-                    case.index.to_string(),
-                    order.to_string(),
-                    format!("{hemisphere:?}"),
-                    channel.to_string(),
-                    cos_lo.to_string(),
-                    phi_lo.to_string(),
-                );
-                out.push(Prediction {
-                    key,
-                    fields: case_fields(case),
-                    value: values(ic * grid.phi_bins + ip),
-                    solid_angle: grid.projected_solid_angle(ic),
-                    bounds: [cos_lo, cos_hi, phi_lo, phi_hi],
-                });
-            }
-        }
-    };
-    // Closed-form models: channel 0 of RGB runs, and a quadrature error far below the
-    // statistical error of the measurement.
-    let channel = if config.is_rgb() { "r" } else { "" };
-    let tol = 1e-3 / (sim_photons as f64 * grid.bins() as f64);
-    match model {
-        Model::Single => {
-            for case in &cases {
-                for &h in crate::io::output::hemispheres(case) {
-                    let Some(bins) = single_scattering_bins(case, &grid, h, tol) else { continue };
-                    rows(case, 1, h, channel, &mut |i| Value { energy: bins[i], stderr: 0.0 }, &mut out);
-                }
-            }
-        }
-        Model::HammonFit => {
-            for case in &cases {
-                for (slot, part) in [(0, HammonFitPart::All), (1, HammonFitPart::Single)] {
-                    let Some(bins) = hammon_fit_bins(case, &grid, part, tol) else { continue };
-                    rows(case, slot, Hemisphere::R, channel, &mut |i| Value { energy: bins[i], stderr: 0.0 }, &mut out);
-                }
-            }
-        }
-        Model::HeitzNee | Model::WangCorrelated | Model::WangUncorrelated | Model::ExactPositionFree => {
-            let estimator = match model {
-                Model::WangCorrelated => Estimator::Wang(Shadowing::Correlated),
-                Model::WangUncorrelated => Estimator::Wang(Shadowing::Uncorrelated),
-                Model::ExactPositionFree => Estimator::PositionFree,
-                _ => Estimator::HeitzNee(NEE_DIRECTIONS),
-            };
-            let model_config = Config { seed, ..config.clone() };
-            let options = RunOptions { estimator, shard: Shard::WHOLE, threads, show_progress: true };
-            let sim = crate::engine::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))?;
-            for_each_lobe(&sim, &mut |case, order, hemisphere, channel, value| {
-                if model != Model::ExactPositionFree || case.position_free_applies() {
-                    rows(case, order, hemisphere, channel, value, &mut out)
-                }
-            });
-        }
-    }
-    Ok(out)
+/// The outcome of `smithwalk compare`: the report to print and the verdicts.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    pub report: String,
+    pub verdicts: Vec<Verdict>,
 }
 
-type LobeVisitor<'a> =
-    dyn FnMut(&crate::setup::cases::Case, usize, Hemisphere, &str, &mut dyn FnMut(usize) -> Value) + 'a;
+impl Outcome {
+    /// Whether an exact oracle rejected a lobe (`--fail-on-reject` turns this into exit status 3).
+    pub fn exact_oracle_rejected(&self) -> bool {
+        self.verdicts.iter().any(|v| is_exact_oracle(v.model) && v.rejected > 0)
+    }
+}
 
-/// Calls `f` for every lobe (case, order, hemisphere, channel) of a simulation with a function
-/// giving each bin's value.
-fn for_each_lobe(sim: &Simulation, f: &mut LobeVisitor<'_>) {
-    fn visit<const C: usize>(
-        case: &crate::setup::cases::Case,
-        d: &crate::engine::detector::Detector<C>,
-        f: &mut LobeVisitor<'_>,
-    ) {
-        let bins = d.grid.bins();
-        let n = d.tallies.photons;
-        for (slot, tallies) in d.tallies.orders.iter().enumerate() {
-            for &h in crate::io::output::hemispheres(case) {
-                for c in 0..C {
-                    let channel = if C > 1 { ["r", "g", "b"][c] } else { "" };
-                    let mut value = |i: usize| {
-                        let (energy, stderr) = tallies.bins[h as usize * bins + i].mean_and_stderr(n, c);
-                        Value { energy, stderr }
-                    };
-                    f(case, slot, h, channel, &mut value);
-                }
-            }
-        }
-    }
-    for (case, result) in sim.cases.iter().zip(&sim.results) {
-        match result {
-            crate::engine::run::CaseResult::Mono(d) => visit(case, d, f),
-            crate::engine::run::CaseResult::Rgb(d) => visit(case, d, f),
-        }
-    }
+/// One model's prediction of one lobe (case, order slot, hemisphere, channel), bin by bin.
+struct ModelLobe {
+    case: usize,
+    order: usize,
+    hemisphere: Hemisphere,
+    channel: usize,
+    energy: Vec<f64>,
+    stderr: Vec<f64>,
+}
+
+/// One model's lobes and what its quadrature (closed-form models) reports.
+#[derive(Default)]
+struct Predictions {
+    lobes: Vec<ModelLobe>,
+    /// Bins stopped at the evaluation bound, and the largest error estimate there in units of
+    /// the bin's tolerance.
+    capped: usize,
+    worst_capped: f64,
+    /// Why the model was not compared, if it was not.
+    skipped: Option<String>,
 }
 
 /// The agreement of one lobe with one model.
 struct LobeComparison {
-    key: LobeKey,
-    fields: Vec<String>,
+    lobe: LobeId,
     model: Model,
     test: ChiSquare,
     rel_l1: f64,
@@ -216,109 +150,412 @@ struct LobeComparison {
     albedo_model: Value,
 }
 
+/// An energy with its standard error.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Value {
+    energy: f64,
+    stderr: f64,
+}
+
 impl LobeComparison {
     fn albedo_diff_se(&self) -> f64 {
         let (a, b) = (self.albedo_measured, self.albedo_model);
-        (a.energy - b.energy) / (a.stderr * a.stderr + b.stderr * b.stderr).sqrt()
+        let se = (a.stderr * a.stderr + b.stderr * b.stderr).sqrt();
+        if se > 0.0 { (a.energy - b.energy) / se } else { 0.0 }
+    }
+}
+
+fn hemisphere_name(h: Hemisphere) -> String {
+    format!("{h:?}")
+}
+
+fn channel_name(rgb: bool, channel: usize) -> &'static str {
+    if rgb { ["r", "g", "b"][channel] } else { "" }
+}
+
+/// The run's folded slot `K` ("K+") when `max_order = K`.
+fn folded_slot(config: &Config) -> Option<usize> {
+    config.detector.max_order.map(|k| k as usize)
+}
+
+/// Whether a lobe is tested: with `max_order = 1` the "1+" slot is the all-orders lobe (slot 0)
+/// again, and one lobe is not tested twice.
+fn is_tested(config: &Config, order: usize) -> bool {
+    !(folded_slot(config) == Some(1) && order == 1)
+}
+
+/// The closed-form models' lobes: `single` (order 1) and `hammon-fit` (order 1, folded into
+/// all orders for a "1+" slot, and all orders), each bin integrated to a tolerance tied to the
+/// measured bin's standard error (channel 0 of RGB runs).
+fn closed_form(model: Model, run: &RunDir, measured: &Lobes, progress: &ProgressBar) -> Predictions {
+    let photons = run.config.paths as f64;
+    let folded = folded_slot(&run.config);
+    if model == Model::Single && folded == Some(1) {
+        return Predictions {
+            skipped: Some(
+                "not compared: `max_order = 1` folds every order into the \"1+\" slot, and single scattering \
+                 is order 1 alone (run with max_order >= 2 to test it)"
+                    .to_string(),
+            ),
+            ..Predictions::default()
+        };
+    }
+    // (case, slot, hemisphere) of every lobe the model predicts.
+    let mut wanted: Vec<(&Case, usize, Hemisphere)> = Vec::new();
+    for case in &run.cases {
+        match model {
+            Model::Single => wanted.extend(hemispheres(case).iter().map(|&h| (case, 1, h))),
+            _ => wanted.extend([(case, 0, Hemisphere::R), (case, 1, Hemisphere::R)]),
+        }
+    }
+    progress.set_length(wanted.len() as u64);
+    let empty: Vec<BinValue> = vec![BinValue::default(); run.grid.bins()];
+    let results: Vec<Option<(ModelLobe, LobeIntegrals, Vec<f64>)>> = wanted
+        .into_iter()
+        .map(|(case, slot, h)| {
+            let bins = measured.get(case.index, slot, &hemisphere_name(h), 0).unwrap_or(&empty);
+            let tolerances: Vec<f64> =
+                bins.iter().map(|b| QUADRATURE_FRACTION * b.energy_stderr.max(1.0 / photons)).collect();
+            let tolerance = |bin: usize| tolerances[bin];
+            let integrals = match model {
+                Model::Single => single_scattering_lobe(case, &run.grid, h, &tolerance),
+                _ => {
+                    let part = if slot == 1 && folded != Some(1) { HammonFitPart::Single } else { HammonFitPart::All };
+                    hammon_fit_lobe_bins(case, &run.grid, part, &tolerance)
+                }
+            };
+            progress.inc(1);
+            integrals.map(|integrals| {
+                let lobe = ModelLobe {
+                    case: case.index,
+                    order: slot,
+                    hemisphere: h,
+                    channel: 0,
+                    energy: integrals.energy.clone(),
+                    stderr: vec![0.0; run.grid.bins()],
+                };
+                (lobe, integrals, tolerances)
+            })
+        })
+        .collect();
+    let mut out = Predictions::default();
+    for (lobe, integrals, tolerances) in results.into_iter().flatten() {
+        out.capped += integrals.capped;
+        if integrals.capped > 0 {
+            for (error, tol) in integrals.error.iter().zip(&tolerances) {
+                out.worst_capped = out.worst_capped.max(error / tol);
+            }
+        }
+        out.lobes.push(lobe);
+    }
+    out
+}
+
+/// The Monte Carlo models' lobes: the model's estimator walked with the run's config (the same
+/// detector, `max_order` included, so the same folding) and `photons` per case.
+fn monte_carlo(
+    model: Model,
+    config: &Config,
+    seed: u64,
+    threads: Option<usize>,
+    progress: bool,
+) -> Result<Predictions> {
+    let estimator = match model {
+        Model::WangCorrelated => Estimator::Wang(Shadowing::Correlated),
+        Model::WangUncorrelated => Estimator::Wang(Shadowing::Uncorrelated),
+        Model::ExactPositionFree => Estimator::PositionFree,
+        _ => Estimator::HeitzNee(NEE_DIRECTIONS),
+    };
+    let model_config = Config { seed, ..config.clone() };
+    let options = RunOptions { estimator, shard: Shard::WHOLE, threads, show_progress: progress };
+    let sim = crate::engine::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))?;
+    let mut out = Predictions::default();
+    for_each_lobe(&sim, &mut |case, lobe| {
+        if model != Model::ExactPositionFree || case.position_free_applies() {
+            out.lobes.push(lobe);
+        }
+    });
+    Ok(out)
+}
+
+/// Calls `f` for every lobe (case, order, hemisphere, channel) of a simulation.
+fn for_each_lobe(sim: &Simulation, f: &mut dyn FnMut(&Case, ModelLobe)) {
+    fn visit<const C: usize>(case: &Case, d: &Detector<C>, f: &mut dyn FnMut(&Case, ModelLobe)) {
+        let bins = d.grid.bins();
+        let n = d.tallies.photons;
+        for (slot, tallies) in d.tallies.orders.iter().enumerate() {
+            for &h in hemispheres(case) {
+                for c in 0..C {
+                    let values: Vec<(f64, f64)> = tallies.bins[h as usize * bins..(h as usize + 1) * bins]
+                        .iter()
+                        .map(|t| t.mean_and_stderr(n, c))
+                        .collect();
+                    f(
+                        case,
+                        ModelLobe {
+                            case: case.index,
+                            order: slot,
+                            hemisphere: h,
+                            channel: c,
+                            energy: values.iter().map(|v| v.0).collect(),
+                            stderr: values.iter().map(|v| v.1).collect(),
+                        },
+                    );
+                }
+            }
+        }
+    }
+    for (case, result) in sim.cases.iter().zip(&sim.results) {
+        match result {
+            CaseResult::Mono(d) => visit(case, d, f),
+            CaseResult::Rgb(d) => visit(case, d, f),
+        }
     }
 }
 
 /// A bin as per-photon moments: mean `e` and second moment `q = Q/N`, recovered from the
 /// written energy and standard error (`se^2 = (q - e^2) / (N - 1)`).
-fn moments(v: Value, photons: u64) -> WeightedBin {
+fn moments(energy: f64, stderr: f64, photons: u64) -> WeightedBin {
     let n = photons as f64;
-    WeightedBin { mean: v.energy, second_moment: v.stderr * v.stderr * (n - 1.0) + v.energy * v.energy }
+    WeightedBin { mean: energy, second_moment: stderr * stderr * (n - 1.0) + energy * energy }
 }
 
 /// Compares one lobe bin by bin with [`stats::two_sample_at_null`] (the model exact when
-/// `model_photons = 0`), pooling bins in which less than 5 photons' worth of energy is
-/// expected; also the relative L1 and L2 errors and the model's albedo.
+/// `model_photons = 0`), pooling bins in which less than [`MIN_COUNT`] photons' worth of energy
+/// is expected; also the relative L1 and L2 errors and the model's albedo (the sum of its bins).
 fn compare_lobe(
-    measured: &HashMap<BinKey, Value>,
-    predictions: &[&Prediction],
+    measured: &[BinValue],
+    model: &ModelLobe,
     photons: u64,
     model_photons: u64,
 ) -> (ChiSquare, f64, f64, Value) {
     let (mut l1, mut l2, mut norm1, mut norm2) = (0.0, 0.0, 0.0, 0.0);
     let (mut albedo, mut albedo_var) = (0.0, 0.0);
-    let (mut observed, mut model) = (Vec::new(), Vec::new());
-    for p in predictions {
-        let m = measured.get(&p.key).copied().unwrap_or_default();
-        let (o, e) = (m.energy, p.value.energy);
+    let (mut observed, mut expected) = (Vec::new(), Vec::new());
+    for ((m, &e), &se) in measured.iter().zip(&model.energy).zip(&model.stderr) {
+        let o = m.energy;
         l1 += (o - e).abs();
         l2 += (o - e) * (o - e);
         norm1 += e.abs();
         norm2 += e * e;
         albedo += e;
-        albedo_var += p.value.stderr * p.value.stderr;
-        observed.push(moments(m, photons));
-        model.push(moments(p.value, model_photons));
+        albedo_var += se * se;
+        observed.push(moments(m.energy, m.energy_stderr, photons));
+        expected.push(moments(e, se, model_photons));
     }
-    let test = stats::two_sample_at_null(&observed, photons, &model, model_photons, 5.0);
+    let test = stats::two_sample_at_null(&observed, photons, &expected, model_photons, MIN_COUNT);
     let rel_l1 = if norm1 > 0.0 { l1 / norm1 } else { 0.0 };
     let rel_l2 = if norm2 > 0.0 { (l2 / norm2).sqrt() } else { 0.0 };
     (test, rel_l1, rel_l2, Value { energy: albedo, stderr: albedo_var.sqrt() })
 }
 
-/// Runs the comparison of `run_dir` with `models` and writes `models.csv` and `compare.csv`
-/// into it; returns the human-readable report.
+/// A progress bar on a terminal naming the model, hidden otherwise.
+fn model_progress(model: Model, terminal: bool) -> ProgressBar {
+    if !terminal {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template("{msg} {elapsed_precise} [{bar:40}] {pos}/{len} lobes")
+            .expect("static template")
+            .progress_chars("=> "),
+    );
+    bar.set_message(model.name());
+    bar
+}
+
+/// CPU seconds used so far by every thread of this process.
+fn cpu_seconds() -> f64 {
+    let t = rustix::time::clock_gettime(rustix::time::ClockId::ProcessCPUTime);
+    t.tv_sec as f64 + 1e-9 * t.tv_nsec as f64
+}
+
+/// A model's value in `models.csv`: six significant digits (a closed-form model's bins are
+/// accurate to 0.05 of the measured standard error, a Monte Carlo model's to its own), and a
+/// zero as `0`.
+fn short(v: f64) -> String {
+    if v == 0.0 { "0".to_string() } else { format!("{v:.5e}") }
+}
+
+/// [`compare_with`] at the default family level: the report to print.
 pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Option<usize>) -> Result<String> {
-    let mut config = read_config(run_dir)?;
-    let measured_photons = config.paths;
-    let measured = read_lobes(&run_dir.join("lobes.csv"))?;
-    let summary = read_summary(&run_dir.join("summary.csv"))?;
-    if let Some(p) = paths {
+    compare_with(run_dir, &CompareOptions::new(models.to_vec(), paths, threads)).map(|outcome| outcome.report)
+}
+
+/// Runs the comparison of `run_dir` with the models of `options`, writes `models.csv` and
+/// `compare.csv` into it and returns the report and the verdicts. Progress goes to stderr: on a
+/// terminal the model being evaluated, otherwise one line per model when it finishes.
+pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome> {
+    options.validate()?;
+    let run = RunDir::open(run_dir)?;
+    let measured = run.measured()?;
+    let summary = run.summary()?;
+    let measured_photons = run.config.paths;
+    let mut config = run.config.clone();
+    if let Some(p) = options.paths {
         config.paths = p;
     }
     config.precision = None;
     config.compare = None;
     let rgb = config.is_rgb();
+    let folded = folded_slot(&config);
+    let albedo = |lobe: &LobeId| {
+        summary
+            .iter()
+            .find(|r| {
+                (r.case, r.order, r.hemisphere.as_str(), channel_index(r.channel.as_deref()))
+                    == (lobe.0, lobe.1, lobe.2.as_str(), lobe.3)
+            })
+            .map_or(Value::default(), |r| Value { energy: r.albedo, stderr: r.albedo_stderr })
+    };
+    let terminal = std::io::stderr().is_terminal();
     let mut model_rows = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<&str> = crate::io::output::CASE_COLUMNS.to_vec();
-    header.extend(["model", "order", "hemisphere"]);
+    let mut header = vec!["case", "model", "order", "hemisphere"];
     if rgb {
         header.push("channel");
     }
-    header.extend(["cos_lo", "cos_hi", "phi_lo_deg", "phi_hi_deg", "energy", "energy_stderr", "bsdf"]);
+    header.extend(["cos_lo", "cos_hi", "phi_lo_deg", "phi_hi_deg", "energy", "energy_stderr", "bsdf", "folded"]);
     model_rows.write_record(&header)?;
     let mut comparisons = Vec::new();
-    for (k, &model) in models.iter().enumerate() {
-        let seed = config.seed.wrapping_add(0x9e37_79b9_7f4a_7c15_u64.wrapping_mul(k as u64 + 1));
-        let predictions = predict(model, &config, measured_photons, seed, threads)?;
-        let mut lobes: Vec<(LobeKey, Vec<&Prediction>)> = Vec::new();
-        for p in &predictions {
-            let mut row = p.fields.clone();
-            row.extend([model.name().to_string(), p.key.1.clone(), p.key.2.clone()]);
-            if rgb {
-                row.push(p.key.3.clone());
-            }
-            row.extend(p.bounds.map(|b| b.to_string()));
-            row.extend([p.value.energy, p.value.stderr, p.value.energy / p.solid_angle].map(|v| v.to_string()));
-            model_rows.write_record(&row)?;
-            let lobe = (p.key.0.clone(), p.key.1.clone(), p.key.2.clone(), p.key.3.clone());
-            match lobes.last_mut() {
-                Some((key, bins)) if *key == lobe => bins.push(p),
-                _ => lobes.push((lobe, vec![p])),
-            }
+    let mut notes: Vec<(Model, String)> = Vec::new();
+    let mut skipped: Vec<(Model, String)> = Vec::new();
+    let empty: Vec<BinValue> = vec![BinValue::default(); run.grid.bins()];
+    for (k, &model) in options.models.iter().enumerate() {
+        let (start, cpu_start) = (Instant::now(), cpu_seconds());
+        if terminal {
+            eprintln!("compare: {} ({}/{})", model.name(), k + 1, options.models.len());
         }
-        for (key, bins) in lobes {
-            let albedo_measured = summary.get(&key).copied().unwrap_or_default();
-            let model_photons = if matches!(model, Model::Single | Model::HammonFit) { 0 } else { config.paths };
-            let (test, rel_l1, rel_l2, albedo_model) = compare_lobe(&measured, &bins, measured_photons, model_photons);
+        let seed = config.seed.wrapping_add(0x9e37_79b9_7f4a_7c15_u64.wrapping_mul(k as u64 + 1));
+        let predictions = match model {
+            Model::Single | Model::HammonFit => {
+                let bar = model_progress(model, terminal);
+                let p = closed_form(model, &run, &measured, &bar);
+                bar.finish_and_clear();
+                p
+            }
+            _ => monte_carlo(model, &config, seed, options.threads, terminal)?,
+        };
+        if let Some(reason) = predictions.skipped {
+            skipped.push((model, reason));
+        }
+        if predictions.capped > 0 {
+            notes.push((
+                model,
+                format!(
+                    "the quadrature stopped at its evaluation bound ({MAX_BIN_EVALUATIONS} per bin, \
+                     {MAX_EXIT_BIN_EVALUATIONS} for exit lobes) in {} bins; largest error estimate there: {:.2} \
+                     standard errors of the bin",
+                    predictions.capped,
+                    predictions.worst_capped * QUADRATURE_FRACTION
+                ),
+            ));
+        }
+        let model_photons = if matches!(model, Model::Single | Model::HammonFit) { 0 } else { config.paths };
+        for lobe in &predictions.lobes {
+            let case = &run.cases[lobe.case];
+            let h = hemisphere_name(lobe.hemisphere);
+            let id: LobeId = (lobe.case, lobe.order, h.clone(), lobe.channel);
+            let bins = measured.get(lobe.case, lobe.order, &h, lobe.channel).unwrap_or(&empty);
+            let is_folded = folded == Some(lobe.order);
+            write_model_rows(&mut model_rows, &run.grid, (case, bins), (model, lobe, is_folded), rgb)?;
+            if !is_tested(&config, lobe.order) {
+                continue;
+            }
+            let (test, rel_l1, rel_l2, albedo_model) = compare_lobe(bins, lobe, measured_photons, model_photons);
             comparisons.push(LobeComparison {
-                fields: bins[0].fields.clone(),
-                key,
+                albedo_measured: albedo(&id),
+                lobe: id,
                 model,
                 test,
                 rel_l1,
                 rel_l2,
-                albedo_measured,
                 albedo_model,
             });
         }
+        let tested = comparisons.iter().filter(|c| c.model == model).count();
+        eprintln!(
+            "compare: {} done: {tested} lobes in {:.1} s ({:.1} CPU s)",
+            model.name(),
+            start.elapsed().as_secs_f64(),
+            cpu_seconds() - cpu_start
+        );
     }
-    let mut compare_rows = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<&str> = crate::io::output::CASE_COLUMNS.to_vec();
+    let verdicts: Vec<Verdict> = options
+        .models
+        .iter()
+        .map(|&model| {
+            let mine: Vec<&LobeComparison> = comparisons.iter().filter(|c| c.model == model).collect();
+            let level = stats::sidak(options.family_level, mine.len().max(1));
+            Verdict {
+                model,
+                lobes: mine.len(),
+                rejected: mine.iter().filter(|c| c.test.p_value < level).count(),
+                skipped: skipped.iter().find(|s| s.0 == model).map(|s| s.1.clone()),
+            }
+        })
+        .collect();
+    let compare_csv = compare_table(&comparisons, &run, &verdicts, options.family_level, rgb, folded)?;
+    write_atomically(run_dir, &[("models.csv", model_rows.into_inner()?), ("compare.csv", compare_csv)])?;
+    let report = report(&comparisons, &verdicts, &notes, options.family_level, rgb, folded);
+    Ok(Outcome { report, verdicts })
+}
+
+fn channel_index(channel: Option<&str>) -> usize {
+    match channel {
+        Some("g") => 1,
+        Some("b") => 2,
+        _ => 0,
+    }
+}
+
+/// The rows of one model lobe in `models.csv`: one per bin of the lobe in `lobes.csv` (whose
+/// `measured` values are given) that the run or the model put energy into; the bins left out
+/// are zero in both. The case is named by its index (its parameters are in `compare.csv`,
+/// `lobes.csv` and `summary.csv`).
+fn write_model_rows(
+    w: &mut csv::Writer<Vec<u8>>,
+    grid: &Grid,
+    (case, measured): (&Case, &[BinValue]),
+    (model, lobe, folded): (Model, &ModelLobe, bool),
+    rgb: bool,
+) -> Result<()> {
+    let sign = hemisphere_sign(case.side, lobe.hemisphere);
+    for ic in 0..grid.cos_bins {
+        let (lo, hi) = grid.cos_edges(ic);
+        let (cos_lo, cos_hi) = if sign > 0.0 { (lo, hi) } else { (-hi, -lo) };
+        let solid = grid.projected_solid_angle(ic);
+        for ip in 0..grid.phi_bins {
+            let bin = ic * grid.phi_bins + ip;
+            let (e, se) = (lobe.energy[bin], lobe.stderr[bin]);
+            if e == 0.0 && se == 0.0 && measured[bin].energy == 0.0 {
+                continue;
+            }
+            let (phi_lo, phi_hi) = grid.phi_edges_deg(ip);
+            let mut row = vec![case.index.to_string(), model.name().to_string(), lobe.order.to_string()];
+            row.push(hemisphere_name(lobe.hemisphere));
+            if rgb {
+                row.push(channel_name(rgb, lobe.channel).to_string());
+            }
+            row.extend([cos_lo, cos_hi, phi_lo, phi_hi].map(|b| b.to_string()));
+            row.extend([e, se, e / solid].map(short));
+            row.push(folded.to_string());
+            w.write_record(&row)?;
+        }
+    }
+    Ok(())
+}
+
+/// The text of `compare.csv`: one row per tested lobe and model.
+fn compare_table(
+    comparisons: &[LobeComparison],
+    run: &RunDir,
+    verdicts: &[Verdict],
+    family_level: f64,
+    rgb: bool,
+    folded: Option<usize>,
+) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<&str> = CASE_COLUMNS.to_vec();
     header.extend(["model", "order", "hemisphere"]);
     if rgb {
         header.push("channel");
@@ -334,13 +571,19 @@ pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Op
         "albedo_model",
         "albedo_model_stderr",
         "albedo_diff_se",
+        "folded",
+        "family_level",
+        "lobe_level",
+        "rejected",
     ]);
-    compare_rows.write_record(&header)?;
-    for c in &comparisons {
-        let mut row = c.fields.clone();
-        row.extend([c.model.name().to_string(), c.key.1.clone(), c.key.2.clone()]);
+    w.write_record(&header)?;
+    for c in comparisons {
+        let lobes = verdicts.iter().find(|v| v.model == c.model).map_or(1, |v| v.lobes);
+        let lobe_level = stats::sidak(family_level, lobes.max(1));
+        let mut row = case_fields(&run.cases[c.lobe.0]);
+        row.extend([c.model.name().to_string(), c.lobe.1.to_string(), c.lobe.2.clone()]);
         if rgb {
-            row.push(c.key.3.clone());
+            row.push(channel_name(rgb, c.lobe.3).to_string());
         }
         row.extend([c.test.statistic.to_string(), c.test.dof.to_string(), c.test.p_value.to_string()]);
         row.extend(
@@ -355,46 +598,123 @@ pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Op
             ]
             .map(|v| v.to_string()),
         );
-        compare_rows.write_record(&row)?;
+        row.extend([
+            (folded == Some(c.lobe.1)).to_string(),
+            family_level.to_string(),
+            lobe_level.to_string(),
+            (c.test.p_value < lobe_level).to_string(),
+        ]);
+        w.write_record(&row)?;
     }
-    write_atomically(
-        run_dir,
-        &[("models.csv", model_rows.into_inner()?), ("compare.csv", compare_rows.into_inner()?)],
-    )?;
-    Ok(report(&comparisons, models))
+    Ok(w.into_inner()?)
 }
 
-/// The worst lobes per model: lowest p-values, with their lobe errors and albedo differences.
-fn report(comparisons: &[LobeComparison], models: &[Model]) -> String {
+/// The report: per model its family, level, rejections and worst lobes, then the verdict.
+fn report(
+    comparisons: &[LobeComparison],
+    verdicts: &[Verdict],
+    notes: &[(Model, String)],
+    family_level: f64,
+    rgb: bool,
+    folded: Option<usize>,
+) -> String {
     let mut out = String::new();
-    for &model in models {
-        let mut mine: Vec<&LobeComparison> = comparisons.iter().filter(|c| c.model == model).collect();
-        if mine.is_empty() {
-            let _ = writeln!(out, "{}: applies to no case of this run", model.name());
+    for v in verdicts {
+        let kind = if is_exact_oracle(v.model) { "exact oracle" } else { "approximation" };
+        if let Some(reason) = &v.skipped {
+            let _ = writeln!(out, "{} ({kind}): {reason}", v.model.name());
             continue;
         }
-        mine.sort_by(|a, b| a.test.p_value.total_cmp(&b.test.p_value));
-        let _ = writeln!(out, "{} ({} lobes), worst first:", model.name(), mine.len());
+        if v.lobes == 0 {
+            let _ = writeln!(out, "{} ({kind}): applies to no case of this run", v.model.name());
+            continue;
+        }
+        let level = stats::sidak(family_level, v.lobes);
         let _ = writeln!(
             out,
-            "  {:>5} {:>5} {:>4} {:>10} {:>6} {:>10} {:>8} {:>8} {:>11}",
-            "case", "order", "hemi", "chi2", "dof", "p", "rel L1", "rel L2", "albedo diff"
+            "{} ({kind}): {} lobes at family level {family_level} (Sidak: each lobe at {level:.2e}): {} rejected",
+            v.model.name(),
+            v.lobes,
+            v.rejected
+        );
+        for (model, note) in notes.iter().filter(|n| n.0 == v.model) {
+            let _ = writeln!(out, "  {}: {note}", model.name());
+        }
+        let mut mine: Vec<&LobeComparison> = comparisons.iter().filter(|c| c.model == v.model).collect();
+        mine.sort_by(|a, b| a.test.p_value.total_cmp(&b.test.p_value));
+        let _ = writeln!(
+            out,
+            "  {:>5} {:>5} {:>4} {:>3} {:>10} {:>6} {:>10} {:>8} {:>8} {:>11}  worst first",
+            "case", "order", "hemi", "ch", "chi2", "dof", "p", "rel L1", "rel L2", "albedo diff"
         );
         for c in mine.iter().take(5) {
+            let order = if folded == Some(c.lobe.1) { format!("{}+", c.lobe.1) } else { c.lobe.1.to_string() };
+            let channel = if rgb { channel_name(rgb, c.lobe.3) } else { "-" };
             let _ = writeln!(
                 out,
-                "  {:>5} {:>5} {:>4} {:>10.1} {:>6} {:>10.2e} {:>8.4} {:>8.4} {:>8.1} SE",
-                c.key.0,
-                c.key.1,
-                c.key.2,
+                "  {:>5} {order:>5} {:>4} {channel:>3} {:>10.1} {:>6} {:>10.2e} {:>8.4} {:>8.4} {:>8.1} SE{}",
+                c.lobe.0,
+                c.lobe.2,
                 c.test.statistic,
                 c.test.dof,
                 c.test.p_value,
                 c.rel_l1,
                 c.rel_l2,
-                c.albedo_diff_se()
+                c.albedo_diff_se(),
+                if c.test.p_value < level { "  rejected" } else { "" }
             );
         }
     }
+    if folded == Some(1) {
+        let _ = writeln!(out, "(max_order = 1: the \"1+\" slot is the all-orders lobe, tested once as order 0)");
+    }
+    let failed: Vec<String> = verdicts
+        .iter()
+        .filter(|v| is_exact_oracle(v.model) && v.rejected > 0)
+        .map(|v| format!("{} ({} of {} lobes)", v.model.name(), v.rejected, v.lobes))
+        .collect();
+    let approximations: Vec<&str> =
+        verdicts.iter().filter(|v| !is_exact_oracle(v.model) && v.rejected > 0).map(|v| v.model.name()).collect();
+    if failed.is_empty() {
+        let _ = writeln!(out, "verdict: no exact oracle rejects the run at family level {family_level}");
+    } else {
+        let _ = writeln!(
+            out,
+            "verdict: REJECTED by exact oracles: {}: the measurement or the oracle is wrong",
+            failed.join(", ")
+        );
+    }
+    if !approximations.is_empty() {
+        let _ = writeln!(
+            out,
+            "({} {} the walk: rejections measure the approximation, not a fault)",
+            approximations.join(", "),
+            if approximations.len() == 1 { "approximates" } else { "approximate" }
+        );
+    }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn single_scattering_is_never_tested_against_a_slot_that_holds_other_orders() {
+        let mut config: Config = toml::from_str(
+            "paths = 1000\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 0\n\
+             [detector]\ncos_theta_bins = 2\nphi_bins = 2\nmax_order = 1\n",
+        )
+        .unwrap();
+        // max_order = 1: slot 1 is "1+" = slot 0, tested once, and `single` is skipped.
+        assert!(is_tested(&config, 0) && !is_tested(&config, 1));
+        config.detector.max_order = Some(2);
+        assert!(is_tested(&config, 1) && is_tested(&config, 2));
+    }
+
+    #[test]
+    fn exact_oracles_are_the_models_exact_for_the_smith_walk() {
+        let exact: Vec<&str> = Model::ALL.into_iter().filter(|&m| is_exact_oracle(m)).map(Model::name).collect();
+        assert_eq!(exact, ["single", "heitz-nee", "exact-position-free"]);
+    }
 }

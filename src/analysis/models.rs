@@ -1,6 +1,8 @@
 //! Analytic models evaluated in the detector's bins, integrated over each bin by adaptive
-//! quadrature (§4.7: evaluating at bin centres is biased for peaked lobes): exact single
-//! scattering of every facet material (§5) and Hammon 2017's closed-form fit.
+//! cubature (§4.7: evaluating at bin centres is biased for peaked lobes): exact single
+//! scattering of every facet material (§5) and Hammon 2017's closed-form fit. Each bin gets its
+//! own tolerance (`smithwalk compare` ties it to the measured bin's standard error) and a
+//! bound on evaluations, so that every lobe terminates, however peaked.
 
 use std::f64::consts::{PI, TAU};
 
@@ -10,7 +12,7 @@ use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, slope_to_normal};
 use microsurface::single;
 use rayon::prelude::*;
 
-use crate::analysis::quadrature::{gauss_legendre, integrate_2d};
+use crate::analysis::quadrature::{Peak, cubature, gauss_legendre};
 use crate::engine::detector::{Grid, Hemisphere};
 use crate::setup::cases::Case;
 use crate::setup::config::{FresnelKind, IncidentSide, MaterialConfig, NdfKind, NormalsKind, SmithKind};
@@ -129,23 +131,59 @@ fn beckmann_visible_rule(ndf: &Beckmann, wi: DVec3) -> Vec<(DVec3, f64)> {
     rule
 }
 
+/// Evaluations of a lobe's integrand one bin may spend (about 1 200 cells of the product
+/// rule): the bound that makes every lobe terminate, whatever its roughness and tolerance.
+pub const MAX_BIN_EVALUATIONS: usize = 60_000;
+
+/// The same bound for lobes with an exit term (diffuse and Hammon facets), whose every
+/// evaluation sums over a visible-normal rule of 2 048 or 9 216 nodes: 8 cells of 49 nodes.
+pub const MAX_EXIT_BIN_EVALUATIONS: usize = 8 * 49;
+
+/// A model's lobe integrated over every bin of a hemisphere (index `cos * phi_bins + phi`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LobeIntegrals {
+    /// Expected energy per photon in each bin.
+    pub energy: Vec<f64>,
+    /// Each bin's quadrature error estimate.
+    pub error: Vec<f64>,
+    /// Bins where [`MAX_BIN_EVALUATIONS`] stopped the refinement before the tolerance.
+    pub capped: usize,
+}
+
 /// Expected order-1 energy per photon in every bin of `hemisphere` (index `cos * phi_bins +
-/// phi`), or `None` where single scattering is not available: Hammon's Smith or normals, or
-/// light from inside.
+/// phi`), to the absolute tolerance `abs_tol` per bin, or `None` where single scattering is
+/// not available: Hammon's Smith or normals, or light from inside.
 pub fn single_scattering_bins(case: &Case, grid: &Grid, hemisphere: Hemisphere, abs_tol: f64) -> Option<Vec<f64>> {
+    single_scattering_lobe(case, grid, hemisphere, &|_| abs_tol).map(|lobe| lobe.energy)
+}
+
+/// [`single_scattering_bins`] with a tolerance per bin, `tolerance(bin)`, and the quadrature's
+/// error estimates and bound.
+pub fn single_scattering_lobe(
+    case: &Case,
+    grid: &Grid,
+    hemisphere: Hemisphere,
+    tolerance: &(dyn Fn(usize) -> f64 + Sync),
+) -> Option<LobeIntegrals> {
     if case.smith != SmithKind::Exact || case.normals != NormalsKind::Vndf || case.side != IncidentSide::Outside {
         return None;
     }
     let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
     Some(match case.ndf {
-        NdfKind::Ggx => bins_for(&Ggx(roughness), case, grid, hemisphere, abs_tol),
-        NdfKind::Beckmann => bins_for(&Beckmann(roughness), case, grid, hemisphere, abs_tol),
+        NdfKind::Ggx => bins_for(&Ggx(roughness), case, grid, hemisphere, tolerance),
+        NdfKind::Beckmann => bins_for(&Beckmann(roughness), case, grid, hemisphere, tolerance),
     })
 }
 
-fn bins_for<N: Ndf>(ndf: &N, case: &Case, grid: &Grid, hemisphere: Hemisphere, abs_tol: f64) -> Vec<f64> {
+fn bins_for<N: Ndf>(
+    ndf: &N,
+    case: &Case,
+    grid: &Grid,
+    hemisphere: Hemisphere,
+    tolerance: &(dyn Fn(usize) -> f64 + Sync),
+) -> LobeIntegrals {
     if hemisphere == Hemisphere::T && !case.material.transmits() {
-        return vec![0.0; grid.bins()];
+        return LobeIntegrals { energy: vec![0.0; grid.bins()], error: vec![0.0; grid.bins()], capped: 0 };
     }
     let wi = case.incident_direction();
     let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
@@ -158,52 +196,72 @@ fn bins_for<N: Ndf>(ndf: &N, case: &Case, grid: &Grid, hemisphere: Hemisphere, a
         }
         _ => Vec::new(),
     };
-    // The exit lobes are sums over the visible-normal rule with a kink per node, where adaptive
-    // refinement crawls; a fixed 12 x 12 Gauss–Legendre rule per bin resolves them instead.
-    let rule = if visible.is_empty() { BinRule::Adaptive(abs_tol) } else { BinRule::GaussLegendre(12) };
-    integrate_bins(case, grid, hemisphere, rule, |wo| single_lobe(ndf, &case.material, wi, wo, &visible))
+    // Diffuse facets scatter about their normals: no specular peak.
+    let peak = match case.material {
+        MaterialConfig::Diffuse { .. } => None,
+        MaterialConfig::Dielectric { eta, .. } => specular_peak(case, hemisphere, eta),
+        _ => specular_peak(case, hemisphere, 1.0),
+    };
+    let bound = if visible.is_empty() { MAX_BIN_EVALUATIONS } else { MAX_EXIT_BIN_EVALUATIONS };
+    let lobe = |wo| single_lobe(ndf, &case.material, wi, wo, &visible);
+    integrate_bins(case, grid, hemisphere, (peak, tolerance, bound), lobe)
 }
 
-/// How a lobe is integrated over a bin.
-#[derive(Clone, Copy, Debug)]
-enum BinRule {
-    /// Adaptive Gauss–Kronrod to this absolute tolerance.
-    Adaptive(f64),
-    /// A fixed `n x n` Gauss–Legendre product rule.
-    GaussLegendre(usize),
+/// Where a specular lobe peaks in bin coordinates (`|cos theta_o|`, phi from the incident
+/// azimuth) and its width there: the mirror direction in reflection, the direction refracted
+/// by the macro-surface in transmission (none beyond total internal reflection), both at phi =
+/// pi. A facet tilt of alpha in the plane of incidence turns the outgoing direction by about 2
+/// alpha, which is `2 alpha sin theta_o + 2 alpha^2` in `|cos theta|`; a tilt across it turns
+/// the reflected direction by `2 alpha cos theta_i` sideways, `2 alpha cos theta_i / sin
+/// theta_o` in phi, which is tiny at grazing incidence. The scales are taken a little smaller.
+fn specular_peak(case: &Case, hemisphere: Hemisphere, eta: f64) -> Option<Peak> {
+    let sin_i = case.theta_i_deg.to_radians().sin();
+    let sin_o = match hemisphere {
+        Hemisphere::R => sin_i,
+        Hemisphere::T => sin_i / eta,
+    };
+    if sin_o >= 1.0 {
+        return None;
+    }
+    let alpha = case.alpha_x.min(case.alpha_y);
+    let (cos_i, cos_o) = ((1.0 - sin_i * sin_i).sqrt(), (1.0 - sin_o * sin_o).sqrt());
+    Some(Peak {
+        at: (cos_o, std::f64::consts::PI),
+        scale: (alpha * (sin_o + alpha), (alpha * cos_i.min(cos_o) / sin_o.max(alpha)).min(PI)),
+    })
 }
 
 /// Integrates a cosine-weighted lobe `wo -> f(wi, wo) |cos theta_o|` over every bin of
-/// `hemisphere` (index `cos * phi_bins + phi`; phi from the incident azimuth).
+/// `hemisphere` (index `cos * phi_bins + phi`; phi from the incident azimuth), each to its
+/// `tolerance(bin)` within `bound` evaluations, graded towards `peak` where it lies.
 fn integrate_bins(
     case: &Case,
     grid: &Grid,
     hemisphere: Hemisphere,
-    rule: BinRule,
+    (peak, tolerance, bound): (Option<Peak>, &(dyn Fn(usize) -> f64 + Sync), usize),
     lobe: impl Fn(DVec3) -> f64 + Sync,
-) -> Vec<f64> {
+) -> LobeIntegrals {
     let phi_i = case.phi_i_deg.to_radians();
     let sign = match hemisphere {
         Hemisphere::R => 1.0,
         Hemisphere::T => -1.0,
     };
     let dphi = TAU / grid.phi_bins as f64;
-    (0..grid.bins())
+    let bins: Vec<_> = (0..grid.bins())
         .into_par_iter()
         .map(|bin| {
-            let (lo, hi) = grid.cos_edges(bin / grid.phi_bins);
+            let u = grid.cos_edges(bin / grid.phi_bins);
             let ip = bin % grid.phi_bins;
             let phi = (ip as f64 * dphi, (ip + 1) as f64 * dphi);
             let f = |u: f64, p: f64| lobe(direction(u, p, phi_i, sign));
-            match rule {
-                BinRule::Adaptive(tol) => integrate_2d(f, (lo, hi), phi, tol).0,
-                BinRule::GaussLegendre(n) => {
-                    let (us, ps) = (gauss_legendre(n, lo, hi), gauss_legendre(n, phi.0, phi.1));
-                    us.iter().map(|&(u, wu)| ps.iter().map(|&(p, wp)| wu * wp * f(u, p)).sum::<f64>()).sum()
-                }
-            }
+            cubature(f, u, phi, peak, tolerance(bin), bound)
         })
-        .collect()
+        .collect();
+    LobeIntegrals {
+        energy: bins.iter().map(|b| b.value).collect(),
+        error: bins.iter().map(|b| b.error).collect(),
+        capped: bins.iter().filter(|b| b.capped).count(),
+    }
 }
 
 /// Which part of Hammon's fit to evaluate.
@@ -245,15 +303,27 @@ pub fn hammon_fit_lobe(alpha: f64, f0: f64, albedo: f64, wi: DVec3, wo: DVec3, p
 }
 
 /// Expected energy per photon of Hammon's fit in every reflection bin of a `hammon` case
-/// (isotropic GGX, light from outside; channel 0), or `None` where it does not apply.
+/// (isotropic GGX, light from outside; channel 0) to `abs_tol` per bin, or `None` where it does
+/// not apply.
 pub fn hammon_fit_bins(case: &Case, grid: &Grid, part: HammonFitPart, abs_tol: f64) -> Option<Vec<f64>> {
+    hammon_fit_lobe_bins(case, grid, part, &|_| abs_tol).map(|lobe| lobe.energy)
+}
+
+/// [`hammon_fit_bins`] with a tolerance per bin and the quadrature's error estimates and bound.
+pub fn hammon_fit_lobe_bins(
+    case: &Case,
+    grid: &Grid,
+    part: HammonFitPart,
+    tolerance: &(dyn Fn(usize) -> f64 + Sync),
+) -> Option<LobeIntegrals> {
     let MaterialConfig::Hammon { f0, albedo, .. } = &case.material else { return None };
     if case.ndf != NdfKind::Ggx || case.alpha_x != case.alpha_y || case.side != IncidentSide::Outside {
         return None;
     }
     let (f0, albedo) = (f0.to_array::<1>()[0], albedo.to_array::<1>()[0]);
     let wi = case.incident_direction();
-    Some(integrate_bins(case, grid, Hemisphere::R, BinRule::Adaptive(abs_tol), |wo| {
+    let peak = specular_peak(case, Hemisphere::R, 1.0);
+    Some(integrate_bins(case, grid, Hemisphere::R, (peak, tolerance, MAX_BIN_EVALUATIONS), |wo| {
         hammon_fit_lobe(case.alpha_x, f0, albedo, wi, wo, part)
     }))
 }

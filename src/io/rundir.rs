@@ -12,29 +12,6 @@ use crate::engine::detector::Grid;
 use crate::setup::cases::Case;
 use crate::setup::config::Config;
 
-/// A CSV table of a run directory, read whole, with its columns found by name.
-pub(crate) struct Table {
-    pub path: PathBuf,
-    pub headers: csv::StringRecord,
-    pub records: Vec<csv::StringRecord>,
-}
-
-impl Table {
-    pub fn read(path: &Path) -> Result<Self> {
-        let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
-        let headers = reader.headers()?.clone();
-        let records = reader.records().collect::<Result<Vec<_>, _>>()?;
-        Ok(Self { path: path.to_path_buf(), headers, records })
-    }
-
-    pub fn column(&self, name: &str) -> Result<usize> {
-        self.headers
-            .iter()
-            .position(|h| h == name)
-            .with_context(|| format!("{}: no column {name}", self.path.display()))
-    }
-}
-
 /// The resolved, validated config of a finished run, from its `run.json`.
 pub fn read_config(run_dir: &Path) -> Result<Config> {
     let run_json = run_dir.join("run.json");
