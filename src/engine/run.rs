@@ -96,9 +96,16 @@ impl RunSettings {
         self.paths.div_ceil(CHUNK)
     }
 
-    /// Photons of one case that this shard walks.
+    /// Photons of one case that this shard walks: whole chunks, and the short last chunk of
+    /// the case if it is this shard's (closed form: the photon count may be huge).
     pub fn shard_paths(&self) -> u64 {
-        (self.shard.index..self.chunks()).step_by(self.shard.count as usize).map(|c| self.chunk_photons(c)).sum()
+        let chunks = self.shard_chunks();
+        let last = self.chunks().saturating_sub(1);
+        match chunks {
+            0 => 0,
+            _ if last % self.shard.count == self.shard.index => (chunks - 1) * CHUNK + self.chunk_photons(last),
+            _ => chunks * CHUNK,
+        }
     }
 
     fn chunk_photons(&self, chunk: u64) -> u64 {
@@ -384,7 +391,7 @@ impl RunSettings {
     }
 
     /// Rounds of this shard.
-    fn rounds(&self) -> u64 {
+    pub(crate) fn rounds(&self) -> u64 {
         self.shard_chunks().div_ceil(ROUND_CHUNKS)
     }
 
