@@ -30,14 +30,17 @@ pub struct DirLock {
 /// Locks `dir` (which must exist): exclusively for a process that writes a run into it, shared
 /// for one that reads a finished run. A run then removes the temporary files a killed process
 /// left there: while it holds the exclusive lock, no other smithwalk writes into `dir`.
-/// A directory where no lock file can be made (read-only) is read without a lock.
+/// A reader of a directory without a lock file (not written by `run`, or read-only) reads it
+/// without a lock.
 pub fn lock_dir(dir: &Path, exclusive: bool) -> Result<DirLock> {
     let path = dir.join(LOCK_FILE);
-    let file = match std::fs::OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path) {
-        Ok(f) => f,
-        Err(_) if !exclusive => return Ok(DirLock { _file: None }),
-        Err(e) => return Err(e).with_context(|| format!("cannot create the lock file {}", path.display())),
-    };
+    // A reader writes nothing: without a lock file, no run has locked the directory.
+    let file =
+        match std::fs::OpenOptions::new().read(true).write(exclusive).create(exclusive).truncate(false).open(&path) {
+            Ok(f) => f,
+            Err(_) if !exclusive => return Ok(DirLock { _file: None }),
+            Err(e) => return Err(e).with_context(|| format!("cannot create the lock file {}", path.display())),
+        };
     let locked = if exclusive { file.try_lock() } else { file.try_lock_shared() };
     match locked {
         Ok(()) => {}

@@ -539,6 +539,12 @@ impl PrecisionConfig {
 /// The most photons per case.
 pub const MAX_PATHS: u64 = 1_000_000_000_000_000;
 
+/// The roughest surface a walk supports. A walk makes about `alpha` bounces (order 1152 at
+/// alpha 1e3, 105 770 at 1e5 at 60 deg, 64 photons): at 1e6, 14% of the energy passes the
+/// 2^20-interaction cap and is lost as runaway, so 1e4 keeps a factor of 100 to it (measured,
+/// docs/reliability.md).
+pub const MAX_ALPHA: f64 = 1e4;
+
 /// The most cases a sweep may expand to.
 pub const MAX_CASES: u64 = 1_000_000;
 
@@ -597,8 +603,13 @@ impl Config {
         for a in s.alpha.values() {
             let (x, y) = a.xy();
             for v in [x, y] {
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(invalid("surface.alpha", v, "a finite roughness > 0 (tested from 1e-3 to 3)"));
+                if !(v.is_finite() && v > 0.0 && v <= MAX_ALPHA) {
+                    return Err(invalid(
+                        "surface.alpha",
+                        v,
+                        "a roughness in (0, 1e4]: a walk makes about alpha bounces, and from alpha ~1e6 on walks \
+                         pass the 2^20-interaction cap and are lost (docs/reliability.md)",
+                    ));
                 }
             }
         }
