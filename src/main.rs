@@ -230,7 +230,7 @@ fn run(args: RunArgs) -> Result<()> {
         );
     }
     prepare_dir(&out)?;
-    let _lock = lock_dir(&out, true)?;
+    let lock = lock_dir(&out, true)?;
     let (sim, checkpoints) = walk(&args, &config, shard, &out, true)?;
     if shard != Shard::WHOLE {
         let written = write_shard(&sim, &config, shard, &out)?;
@@ -248,6 +248,8 @@ fn run(args: RunArgs) -> Result<()> {
     }
     let written = smithwalk::write_outputs(&sim, &config, &out)?;
     checkpoints.finish()?;
+    // The run is complete: its comparison reads it like any reader, under a shared lock.
+    drop(lock);
     finish_run(&sim, &config, &out, &written, args.threads)
 }
 
@@ -404,8 +406,8 @@ fn report(sim: &Simulation, config: &Config, written: &[PathBuf]) -> Result<()> 
 /// The end summary: throughput and each case's energy balance (channel 0 for RGB runs).
 fn print_summary(sim: &Simulation, config: &Config, written: &[PathBuf]) -> std::io::Result<()> {
     let mut out = std::io::stdout().lock();
-    let total = config.paths * sim.cases.len() as u64;
-    let rate = total as f64 / sim.wall_seconds;
+    let total = config.paths as f64 * sim.cases.len() as f64;
+    let rate = total / sim.wall_seconds;
     writeln!(
         out,
         "{} cases x {} paths in {:.2} s on {} threads: {rate:.3e} paths/s ({:.3e} per thread)",

@@ -3,8 +3,8 @@
 //! TOML, its line); random command lines never panic the binary and every error is one line;
 //! random damage to a run directory never panics `RunDir::open` and is never accepted.
 //!
-//! Case counts: 512 configs, 48 command lines, 256 damaged run directories (about 10 s in
-//! release on 2 cores).
+//! Case counts: 512 configs, 48 command lines, 256 damaged run directories (in
+//! release on 2 cores, measured 0.9 s).
 
 use std::path::Path;
 use std::process::Command;

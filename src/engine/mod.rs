@@ -165,7 +165,7 @@ pub fn simulate_from(
             })
             .collect(),
     };
-    let total = settings.shard_paths() * cases.len() as u64;
+    let total = settings.shard_paths().saturating_mul(cases.len() as u64);
     let progress = if options.show_progress { ProgressBar::new(total) } else { ProgressBar::hidden() };
     progress.set_style(
         ProgressStyle::with_template(

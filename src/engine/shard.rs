@@ -182,7 +182,7 @@ fn merge_files(files: &[ShardFile], origins: &[String]) -> Result<(Config, Simul
         let missing: Vec<String> =
             (0..count).filter(|i| !seen.contains(i)).take(8).map(|i| format!("{i}/{count}")).collect();
         let more = if count - seen.len() as u64 > 8 { ", ..." } else { "" };
-        bail!("missing {} of {count} shards: {}{more}", count - seen.len() as u64, missing.join(", "));
+        bail!("missing shards: {}{more} ({} of {count})", missing.join(", "), count - seen.len() as u64);
     }
     let config = Config::parse(&first.config_toml).context("the shards' config")?;
     let cases = expand(&config);

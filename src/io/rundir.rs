@@ -85,6 +85,29 @@ impl Shape<'_> {
     fn hemispheres(&self, case: usize) -> usize {
         if self.cases[case].material.transmits() { 2 } else { 1 }
     }
+
+    /// The first row of each case in `table` when case `i` has `rows(hemispheres, slots)`
+    /// rows, and a mark per row, once the table is checked to have them all.
+    fn rows(&self, table: &Table, rows: impl Fn(usize, usize) -> usize) -> Result<(Vec<usize>, Vec<bool>)> {
+        let mut offsets = Vec::with_capacity(self.slots.len());
+        let mut total = 0usize;
+        for (i, &slots) in self.slots.iter().enumerate() {
+            offsets.push(total);
+            // Saturating: a forged run.json may claim any number of slots.
+            total = total.saturating_add(rows(self.hemispheres(i), slots));
+        }
+        if table.records.len() != total {
+            bail!("{} has {} rows, but the run in run.json has {total}", table.path.display(), table.records.len());
+        }
+        Ok((offsets, vec![false; total]))
+    }
+
+    /// The case of a row and its number of order slots.
+    fn case_of(&self, r: &csv::StringRecord, column: usize, at: &dyn Fn() -> String) -> Result<(usize, usize)> {
+        let case = index(r, column, "case", at)?;
+        let slots = self.slots.get(case).with_context(|| format!("{}: case {case} is not a case of the run", at()))?;
+        Ok((case, *slots))
+    }
 }
 
 /// `run.json` of `dir`, checked against the tables beside it.
@@ -207,22 +230,11 @@ fn check_lobes(path: &Path, shape: &Shape) -> Result<()> {
     let values = ["energy", "energy_stderr", "bsdf", "bsdf_stderr"].map(|n| col(n).map(|c| (n, c)));
     let channel_c = table.column("channel").ok();
     let (grid, channels) = (shape.grid, shape.channels);
-    // Row offset of each case: slots x hemispheres x bins x channels before it.
-    let mut offsets = Vec::with_capacity(shape.cases.len() + 1);
-    let mut total = 0usize;
-    for (i, &slots) in shape.slots.iter().enumerate() {
-        offsets.push(total);
-        total += slots * shape.hemispheres(i) * grid.bins() * channels;
-    }
-    if table.records.len() != total {
-        bail!("{} has {} rows, but the run in run.json has {total}", path.display(), table.records.len());
-    }
-    let mut seen = vec![false; total];
+    let (offsets, mut seen) =
+        shape.rows(&table, |hemispheres, slots| slots.saturating_mul(hemispheres * grid.bins() * channels))?;
     for (line, r) in table.records.iter().enumerate() {
         let at = || format!("{} line {}", path.display(), line + 2);
-        let case = index(r, case_c, "case", &at)?;
-        let slots =
-            *shape.slots.get(case).with_context(|| format!("{}: case {case} is not a case of the run", at()))?;
+        let (case, slots) = shape.case_of(r, case_c, &at)?;
         let order = index(r, order_c, "order", &at)?;
         if order >= slots {
             bail!("{}: order {order} is not a slot of case {case} ({slots} slots)", at());
@@ -266,21 +278,12 @@ fn check_summary(path: &Path, shape: &Shape) -> Result<()> {
     let channel_c = table.column("channel").ok();
     let channels = shape.channels;
     // Per case: slots x hemispheres albedo rows, then absorbed and lost, each per channel.
-    let mut offsets = Vec::with_capacity(shape.cases.len());
-    let mut total = 0usize;
-    for (i, &slots) in shape.slots.iter().enumerate() {
-        offsets.push(total);
-        total += (slots * shape.hemispheres(i) + 2) * channels;
-    }
-    if table.records.len() != total {
-        bail!("{} has {} rows, but the run in run.json has {total}", path.display(), table.records.len());
-    }
-    let mut seen = vec![false; total];
+    let (offsets, mut seen) = shape.rows(&table, |hemispheres, slots| {
+        slots.saturating_mul(hemispheres).saturating_add(2).saturating_mul(channels)
+    })?;
     for (line, r) in table.records.iter().enumerate() {
         let at = || format!("{} line {}", path.display(), line + 2);
-        let case = index(r, case_c, "case", &at)?;
-        let slots =
-            *shape.slots.get(case).with_context(|| format!("{}: case {case} is not a case of the run", at()))?;
+        let (case, slots) = shape.case_of(r, case_c, &at)?;
         let order = index(r, order_c, "order", &at)?;
         let paths = index(r, paths_c, "paths", &at)?;
         if paths < 2 {
@@ -433,7 +436,7 @@ impl RunDir {
             );
         }
         let grid = Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins };
-        let slots: Vec<usize> = run.cases.iter().map(|c| c.energy.highest_order + 1).collect();
+        let slots: Vec<usize> = run.cases.iter().map(|c| c.energy.highest_order.saturating_add(1)).collect();
         let shape = Shape { cases: &cases, slots: slots.clone(), channels: if config.is_rgb() { 3 } else { 1 }, grid };
         check_lobes(&path.join(TABLES[0]), &shape)?;
         check_summary(&path.join(TABLES[1]), &shape)?;

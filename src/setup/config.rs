@@ -607,7 +607,7 @@ impl Config {
                     return Err(invalid(
                         "surface.alpha",
                         v,
-                        "a roughness in (0, 1e4]: a walk makes about alpha bounces, and from alpha ~1e6 on walks \
+                        "a roughness > 0 and at most 1e4: a walk makes about alpha bounces, and from alpha ~1e6 on walks \
                          pass the 2^20-interaction cap and are lost (docs/reliability.md)",
                     ));
                 }
