@@ -1,5 +1,6 @@
 //! Files written whole or not at all: every file goes to a temporary file in its directory,
-//! and only when all are complete are they renamed into place.
+//! and only when all are complete are they renamed into place. Directories in use are locked
+//! ([`lock_dir`]), and the temporary files a killed process left are removed by the next one.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -10,8 +11,66 @@ use anyhow::{Context, Result};
 pub fn prepare_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir)
         .with_context(|| format!("--out {}: cannot create the output directory", dir.display()))?;
-    tempfile::NamedTempFile::new_in(dir)
-        .with_context(|| format!("--out {}: the output directory is not writable", dir.display()))?;
+    temp_file(dir).with_context(|| format!("--out {}: the output directory is not writable", dir.display()))?;
+    Ok(())
+}
+
+/// Temporary files start with this prefix, so that leftovers of a killed run can be told apart.
+pub const TEMP_PREFIX: &str = ".smithwalk-tmp-";
+
+/// The advisory lock file of a directory in use.
+pub const LOCK_FILE: &str = ".smithwalk.lock";
+
+/// An advisory lock on a directory, held until dropped (or the process ends, however it ends).
+#[derive(Debug)]
+pub struct DirLock {
+    _file: Option<std::fs::File>,
+}
+
+/// Locks `dir` (which must exist): exclusively for a process that writes a run into it, shared
+/// for one that reads a finished run. A run then removes the temporary files a killed process
+/// left there: while it holds the exclusive lock, no other smithwalk writes into `dir`.
+/// A reader of a directory without a lock file (not written by `run`, or read-only) reads it
+/// without a lock.
+pub fn lock_dir(dir: &Path, exclusive: bool) -> Result<DirLock> {
+    let path = dir.join(LOCK_FILE);
+    // A reader writes nothing: without a lock file, no run has locked the directory.
+    let file =
+        match std::fs::OpenOptions::new().read(true).write(exclusive).create(exclusive).truncate(false).open(&path) {
+            Ok(f) => f,
+            Err(_) if !exclusive => return Ok(DirLock { _file: None }),
+            Err(e) => return Err(e).with_context(|| format!("cannot create the lock file {}", path.display())),
+        };
+    let locked = if exclusive { file.try_lock() } else { file.try_lock_shared() };
+    match locked {
+        Ok(()) => {}
+        Err(std::fs::TryLockError::WouldBlock) if exclusive => anyhow::bail!(
+            "{} is in use by another smithwalk process (it holds {LOCK_FILE}); wait for it to finish or choose \
+             another output directory",
+            dir.display()
+        ),
+        Err(std::fs::TryLockError::WouldBlock) => {
+            anyhow::bail!("{} is being written by a smithwalk run; wait for it to finish", dir.display())
+        }
+        Err(std::fs::TryLockError::Error(e)) => {
+            return Err(e).with_context(|| format!("cannot lock {}", path.display()));
+        }
+    }
+    if exclusive {
+        remove_leftovers(dir)?;
+    }
+    Ok(DirLock { _file: Some(file) })
+}
+
+/// Removes the temporary files of killed processes from `dir`.
+fn remove_leftovers(dir: &Path) -> Result<()> {
+    let entries = std::fs::read_dir(dir).with_context(|| format!("cannot list {}", dir.display()))?;
+    for entry in entries.flatten() {
+        if entry.file_name().to_string_lossy().starts_with(TEMP_PREFIX) {
+            let path = entry.path();
+            std::fs::remove_file(&path).with_context(|| format!("cannot remove the leftover {}", path.display()))?;
+        }
+    }
     Ok(())
 }
 
@@ -32,8 +91,7 @@ pub fn write_file_atomically(out: &Path, bytes: Vec<u8>) -> Result<PathBuf> {
 pub fn write_atomically(dir: &Path, files: &[(&str, Vec<u8>)]) -> Result<Vec<PathBuf>> {
     let mut staged = Vec::new();
     for (file, bytes) in files {
-        let mut tmp = tempfile::NamedTempFile::new_in(dir)
-            .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
+        let mut tmp = temp_file(dir).with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
         tmp.write_all(bytes).with_context(|| format!("cannot write {file}"))?;
         make_readable(tmp.as_file()).with_context(|| format!("cannot set the permissions of {file}"))?;
         tmp.as_file().sync_all().with_context(|| format!("cannot write {file}"))?;
@@ -45,6 +103,10 @@ pub fn write_atomically(dir: &Path, files: &[(&str, Vec<u8>)]) -> Result<Vec<Pat
         written.push(path);
     }
     Ok(written)
+}
+
+fn temp_file(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
+    tempfile::Builder::new().prefix(TEMP_PREFIX).tempfile_in(dir)
 }
 
 /// Output files are ordinary readable files (temporary files start private).

@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
-use smithwalk::atomic::prepare_dir;
+use smithwalk::atomic::{lock_dir, prepare_dir};
 use smithwalk::engine::checkpoint::{self, Checkpointer};
 use smithwalk::engine::run::{Estimator, Shard};
 use smithwalk::engine::shard::write_shard;
@@ -252,6 +252,7 @@ fn run(args: RunArgs) -> Result<()> {
         );
     }
     prepare_dir(&out)?;
+    let lock = lock_dir(&out, true)?;
     let (sim, checkpoints) = walk(&args, &config, shard, &out, true)?;
     if shard != Shard::WHOLE {
         let written = write_shard(&sim, &config, shard, &out)?;
@@ -269,6 +270,8 @@ fn run(args: RunArgs) -> Result<()> {
     }
     let written = smithwalk::write_outputs(&sim, &config, &out)?;
     checkpoints.finish()?;
+    // The run is complete: its comparison reads it like any reader, under a shared lock.
+    drop(lock);
     finish_run(&sim, &config, &out, &written, args.threads)
 }
 
@@ -282,7 +285,8 @@ fn run_config(args: &RunArgs) -> Result<Config> {
         config.seed = s;
     }
     config.validate()?;
-    check_threads(args.threads)?;
+    smithwalk::engine::check_resources(&config, args.threads)?;
+    note_threads(args.threads);
     if !(args.checkpoint_seconds.is_finite() && args.checkpoint_seconds > 0.0) {
         bail!("`--checkpoint-seconds` = {} is not allowed: a positive number of seconds", args.checkpoint_seconds);
     }
@@ -362,6 +366,19 @@ fn check_threads(threads: Option<usize>) -> Result<()> {
     Ok(())
 }
 
+/// A note when `--threads` asks for many more threads than cores: allowed (outputs do not
+/// depend on it), but it only adds overhead.
+fn note_threads(threads: Option<usize>) {
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    if let Some(n) = threads
+        && n > 8 * cores
+    {
+        eprintln!(
+            "note: --threads {n} on {cores} cores: outputs are the same, more threads than cores only add overhead"
+        );
+    }
+}
+
 fn default_out(config_path: &Path) -> PathBuf {
     PathBuf::from("out").join(config_path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()))
 }
@@ -393,6 +410,7 @@ fn lut(config_path: &Path, paths: Option<u64>, threads: Option<usize>, out: Opti
 fn merge(shards: &[PathBuf], out: &Path) -> Result<()> {
     let (config, sim) = smithwalk::engine::shard::merge(shards)?;
     prepare_dir(out)?;
+    let _lock = lock_dir(out, true)?;
     let written = smithwalk::write_outputs(&sim, &config, out)?;
     report(&sim, &config, &written)
 }
@@ -410,8 +428,8 @@ fn report(sim: &Simulation, config: &Config, written: &[PathBuf]) -> Result<()> 
 /// The end summary: throughput, then each case's energy balance with a legend of its columns.
 fn print_summary(sim: &Simulation, config: &Config, written: &[PathBuf]) -> std::io::Result<()> {
     let mut out = std::io::stdout().lock();
-    let total = config.paths * sim.cases.len() as u64;
-    let rate = total as f64 / sim.wall_seconds;
+    let total = config.paths as f64 * sim.cases.len() as f64;
+    let rate = total / sim.wall_seconds;
     writeln!(
         out,
         "{} cases x {} paths in {:.2} s on {} threads: {rate:.3e} paths/s ({:.3e} per thread)",
@@ -425,7 +443,30 @@ fn print_summary(sim: &Simulation, config: &Config, written: &[PathBuf]) -> std:
     for path in written {
         writeln!(out, "wrote {}", path.display())?;
     }
+    warn_losses(sim);
     Ok(())
+}
+
+/// One line on the console when any case lost energy (trapped, NaN or runaway walks): the
+/// tables hold only the energy that escaped or was absorbed, and run.json has the details.
+fn warn_losses(sim: &Simulation) {
+    let balances: Vec<output::EnergyBalance> = sim.results.iter().map(output::EnergyBalance::from_result).collect();
+    let lossy = balances.iter().filter(|e| e.lost() > 0.0).count();
+    let Some((case, worst)) = balances.iter().enumerate().max_by(|a, b| a.1.lost().total_cmp(&b.1.lost())) else {
+        return;
+    };
+    if lossy > 0 {
+        let sum = |v: &[f64]| v.iter().sum::<f64>();
+        eprintln!(
+            "warning: {lossy} of {} cases lost energy; the most case {case}: {:.3e} of the incident energy \
+             (trapped {:.3e}, NaN {:.3e}, runaway {:.3e}); see cases[].energy in run.json",
+            sim.cases.len(),
+            worst.lost(),
+            sum(&worst.lost_trapped),
+            sum(&worst.lost_invalid),
+            sum(&worst.lost_runaway)
+        );
+    }
 }
 
 fn main() -> ExitCode {

@@ -10,14 +10,14 @@ use anyhow::{Context, Result, ensure};
 use serde::{Deserialize, Serialize};
 
 use crate::atomic::write_atomically;
-use crate::engine::run::{CaseState, Shard};
+use crate::engine::run::{CaseState, RunSettings, Shard};
+use crate::engine::sealed::{Kind, seal, unseal};
 use crate::engine::shard::CaseTallies;
 use crate::setup::cases::expand;
 use crate::setup::config::Config;
 
 /// The file a run keeps its checkpoint in, inside its output directory.
 pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
-const FORMAT: &str = "smithwalk-checkpoint-1";
 
 #[derive(Serialize, Deserialize)]
 struct SavedState {
@@ -28,7 +28,6 @@ struct SavedState {
 
 #[derive(Serialize, Deserialize)]
 struct CheckpointFile {
-    format: String,
     version: String,
     config_toml: String,
     shard: Shard,
@@ -71,13 +70,12 @@ impl Checkpointer {
             })
             .collect();
         let file = CheckpointFile {
-            format: FORMAT.into(),
             version: env!("CARGO_PKG_VERSION").into(),
             config_toml: self.config_toml.clone(),
             shard: self.shard,
             states,
         };
-        let bytes = postcard::to_stdvec(&file).context("cannot encode the checkpoint")?;
+        let bytes = seal(Kind::Checkpoint, &postcard::to_stdvec(&file).context("cannot encode the checkpoint")?);
         write_atomically(&self.dir, &[(CHECKPOINT_FILE, bytes)])?;
         self.last = Instant::now();
         Ok(())
@@ -101,13 +99,10 @@ pub fn load(dir: &Path, config: &Config, shard: Shard) -> Result<Option<Vec<Case
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(e) => return Err(e).with_context(|| format!("cannot read {}", path.display())),
     };
-    let file: CheckpointFile =
-        postcard::from_bytes(&bytes).with_context(|| format!("{} is not a smithwalk checkpoint", path.display()))?;
-    ensure!(
-        file.format == FORMAT && file.version == env!("CARGO_PKG_VERSION"),
-        "{}: written by another smithwalk version",
-        path.display()
-    );
+    let origin = path.display().to_string();
+    let file: CheckpointFile = postcard::from_bytes(unseal(Kind::Checkpoint, &bytes, &origin)?)
+        .with_context(|| format!("{origin} is not a smithwalk checkpoint"))?;
+    ensure!(file.version == env!("CARGO_PKG_VERSION"), "{}: written by another smithwalk version", path.display());
     ensure!(
         file.config_toml == toml::to_string(config)? && file.shard == shard,
         "{}: the checkpoint belongs to another config, seed, path count or shard; remove it or run without --resume",
@@ -115,6 +110,11 @@ pub fn load(dir: &Path, config: &Config, shard: Shard) -> Result<Option<Vec<Case
     );
     let cases = expand(config);
     ensure!(file.states.len() == cases.len(), "{}: case count differs", path.display());
+    let rounds = RunSettings { shard, ..RunSettings::from_config(config) }.rounds();
+    for (i, s) in file.states.iter().enumerate() {
+        s.tallies.check(config, i).with_context(|| origin.clone())?;
+        ensure!(s.rounds_done <= rounds, "{origin}: case {i} has {} rounds done of {rounds}", s.rounds_done);
+    }
     Ok(Some(
         file.states
             .into_iter()

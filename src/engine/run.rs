@@ -96,9 +96,16 @@ impl RunSettings {
         self.paths.div_ceil(CHUNK)
     }
 
-    /// Photons of one case that this shard walks.
+    /// Photons of one case that this shard walks: whole chunks, and the short last chunk of
+    /// the case if it is this shard's (closed form: the photon count may be huge).
     pub fn shard_paths(&self) -> u64 {
-        (self.shard.index..self.chunks()).step_by(self.shard.count as usize).map(|c| self.chunk_photons(c)).sum()
+        let chunks = self.shard_chunks();
+        let last = self.chunks().saturating_sub(1);
+        match chunks {
+            0 => 0,
+            _ if last % self.shard.count == self.shard.index => (chunks - 1) * CHUNK + self.chunk_photons(last),
+            _ => chunks * CHUNK,
+        }
     }
 
     fn chunk_photons(&self, chunk: u64) -> u64 {
@@ -384,7 +391,7 @@ impl RunSettings {
     }
 
     /// Rounds of this shard.
-    fn rounds(&self) -> u64 {
+    pub(crate) fn rounds(&self) -> u64 {
         self.shard_chunks().div_ceil(ROUND_CHUNKS)
     }
 
@@ -496,5 +503,31 @@ fn walk_parts(
     }
     if let Some(done) = part {
         let _ = sender.send(done);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The closed form of `shard_paths` against the sum over the shard's chunks.
+    #[test]
+    fn shard_paths_is_the_sum_over_the_shards_chunks() {
+        let config = crate::setup::config::Config::parse(
+            "paths = 2\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 0\n",
+        )
+        .unwrap();
+        for paths in [2, CHUNK - 1, CHUNK, CHUNK + 1, 5 * CHUNK + 7, 9 * CHUNK] {
+            for count in 1..=11 {
+                for index in 0..count {
+                    let s = RunSettings { paths, shard: Shard { index, count }, ..RunSettings::from_config(&config) };
+                    let sum: u64 = (index..s.chunks()).step_by(count as usize).map(|c| s.chunk_photons(c)).sum();
+                    assert_eq!(s.shard_paths(), sum, "paths {paths}, shard {index}/{count}");
+                }
+            }
+        }
+        // 10^19 photons: once a loop over 6 x 10^14 chunks.
+        let s = RunSettings { paths: 10_000_000_000_000_000_000, ..RunSettings::from_config(&config) };
+        assert_eq!(s.shard_paths(), 10_000_000_000_000_000_000);
     }
 }

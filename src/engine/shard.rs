@@ -11,12 +11,12 @@ use crate::atomic::write_atomically;
 use crate::engine::Simulation;
 use crate::engine::detector::{Detector, Grid, Tallies};
 use crate::engine::run::{CaseResult, Shard};
+use crate::engine::sealed::{Kind, seal, unseal};
 use crate::setup::cases::{Case, expand};
 use crate::setup::config::Config;
 
 /// The file a shard writes into its output directory.
 pub const SHARD_FILE: &str = "shard.bin";
-const FORMAT: &str = "smithwalk-shard-1";
 
 /// The raw accumulators of one case, as saved in shard and checkpoint files.
 #[derive(Serialize, Deserialize)]
@@ -52,6 +52,30 @@ impl CaseTallies {
         }
     }
 
+    /// Checks that these tallies fit case `case` of `config` (channels, bins, order slots), so
+    /// that a file of another build or a crafted one cannot index out of bounds.
+    pub(crate) fn check(&self, config: &Config, case: usize) -> Result<()> {
+        fn shape<const C: usize>(t: &Tallies<C>) -> (usize, Vec<usize>) {
+            (C, t.orders.iter().map(|o| o.bins.len()).collect())
+        }
+        let (channels, bins) = match self {
+            CaseTallies::Mono(t) => shape(t),
+            CaseTallies::Rgb(t) => shape(t),
+        };
+        let want_channels = if config.is_rgb() { 3 } else { 1 };
+        let want_bins = 2 * config.detector.cos_theta_bins * config.detector.phi_bins;
+        let max_slots = config.detector.max_order.map_or(usize::MAX, |k| k as usize + 1);
+        ensure!(
+            channels == want_channels
+                && !bins.is_empty()
+                && bins.len() <= max_slots
+                && bins.iter().all(|&b| b == want_bins),
+            "case {case}: the saved tallies do not fit the config ({channels} channels, {} order slots)",
+            bins.len()
+        );
+        Ok(())
+    }
+
     fn mono(&self) -> Option<&Tallies<1>> {
         if let CaseTallies::Mono(t) = self { Some(t) } else { None }
     }
@@ -82,7 +106,6 @@ fn merged<const C: usize>(
 /// accumulators of every case.
 #[derive(Serialize, Deserialize)]
 struct ShardFile {
-    format: String,
     version: String,
     config_toml: String,
     shard: Shard,
@@ -94,7 +117,6 @@ struct ShardFile {
 /// The bytes of a shard: the accumulators of a shard's simulation with the config and share.
 pub fn encode(sim: &Simulation, config: &Config, shard: Shard) -> Result<Vec<u8>> {
     let file = ShardFile {
-        format: FORMAT.into(),
         version: env!("CARGO_PKG_VERSION").into(),
         config_toml: toml::to_string(config).context("cannot serialize the config")?,
         shard,
@@ -102,7 +124,7 @@ pub fn encode(sim: &Simulation, config: &Config, shard: Shard) -> Result<Vec<u8>
         wall_seconds: sim.wall_seconds,
         tallies: sim.results.iter().map(CaseTallies::of).collect(),
     };
-    postcard::to_stdvec(&file).context("cannot encode the shard")
+    Ok(seal(Kind::Shard, &postcard::to_stdvec(&file).context("cannot encode the shard")?))
 }
 
 /// Writes the accumulators of a shard's simulation into `dir/shard.bin`, atomically.
@@ -113,10 +135,8 @@ pub fn write_shard(sim: &Simulation, config: &Config, shard: Shard, dir: &Path) 
 
 /// A shard from its bytes; `origin` names where they came from in errors.
 fn decode(bytes: &[u8], origin: &str) -> Result<ShardFile> {
-    let file: ShardFile =
-        postcard::from_bytes(bytes).with_context(|| format!("{origin} is not a smithwalk shard file"))?;
-    ensure!(file.format == FORMAT, "{origin}: format {:?}, expected {FORMAT:?}", file.format);
-    Ok(file)
+    let payload = unseal(Kind::Shard, bytes, origin)?;
+    postcard::from_bytes(payload).with_context(|| format!("{origin} is not a smithwalk shard file"))
 }
 
 fn read_shard(dir: &Path) -> Result<ShardFile> {
@@ -147,23 +167,36 @@ pub fn merge_bytes(shards: &[(String, Vec<u8>)]) -> Result<(Config, Simulation)>
 fn merge_files(files: &[ShardFile], origins: &[String]) -> Result<(Config, Simulation)> {
     let first = &files[0];
     let count = first.shard.count;
-    let mut seen = vec![false; count as usize];
+    // Indexed by the shards given, not by the count a file claims, which may be huge.
+    let mut seen = std::collections::BTreeSet::new();
     for (file, origin) in files.iter().zip(origins) {
         if file.config_toml != first.config_toml || file.version != first.version {
             bail!("{origin}: shard of a different config or smithwalk version than {}", origins[0]);
         }
-        if file.shard.count != count {
+        if file.shard.count != count || file.shard.index >= count {
             bail!("{origin}: shard {}/{} does not match {} shards", file.shard.index, file.shard.count, count);
         }
-        let slot = &mut seen[file.shard.index as usize];
-        ensure!(!*slot, "{origin}: shard {}/{count} given twice", file.shard.index);
-        *slot = true;
+        ensure!(seen.insert(file.shard.index), "{origin}: shard {}/{count} given twice", file.shard.index);
     }
-    let missing: Vec<String> =
-        seen.iter().enumerate().filter(|(_, s)| !**s).map(|(i, _)| format!("{i}/{count}")).collect();
-    ensure!(missing.is_empty(), "missing shards: {}", missing.join(", "));
+    if seen.len() as u64 != count {
+        let missing: Vec<String> =
+            (0..count).filter(|i| !seen.contains(i)).take(8).map(|i| format!("{i}/{count}")).collect();
+        let more = if count - seen.len() as u64 > 8 { ", ..." } else { "" };
+        bail!("missing shards: {}{more} ({} of {count})", missing.join(", "), count - seen.len() as u64);
+    }
     let config = Config::parse(&first.config_toml).context("the shards' config")?;
     let cases = expand(&config);
+    for (file, origin) in files.iter().zip(origins) {
+        ensure!(
+            file.tallies.len() == cases.len(),
+            "{origin}: {} cases saved, the config has {}",
+            file.tallies.len(),
+            cases.len()
+        );
+        for (i, t) in file.tallies.iter().enumerate() {
+            t.check(&config, i).with_context(|| origin.clone())?;
+        }
+    }
     let grid = Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins };
     let max_order = config.detector.max_order;
     let mut results = Vec::with_capacity(cases.len());

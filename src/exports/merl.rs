@@ -74,6 +74,10 @@ pub fn merl_bytes(sweep: &Sweep) -> Vec<u8> {
 
 /// Writes the MERL file of the sweep in `run_dir` to `out` (atomically).
 pub fn export(run_dir: &Path, out: &Path) -> Result<PathBuf> {
-    let sweep = Sweep::read(&RunDir::open(run_dir)?)?;
+    let run = RunDir::open(run_dir)?;
+    let sweep = Sweep::read(&run)?;
+    if let Some(note) = run.dropped_transmission()? {
+        eprintln!("{note}");
+    }
     write_file_atomically(out, merl_bytes(&sweep))
 }

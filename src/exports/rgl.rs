@@ -218,6 +218,10 @@ pub fn export(run_dir: &Path, out: &Path, resolution: usize) -> Result<PathBuf> 
             RESOLUTIONS.end()
         );
     }
-    let sweep = Sweep::read(&RunDir::open(run_dir)?)?;
+    let run = RunDir::open(run_dir)?;
+    let sweep = Sweep::read(&run)?;
+    if let Some(note) = run.dropped_transmission()? {
+        eprintln!("{note}");
+    }
     write_file_atomically(out, rgl_bytes(&sweep, resolution))
 }

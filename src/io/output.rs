@@ -324,9 +324,33 @@ struct CaseReport<'a> {
     energy: EnergyBalance,
 }
 
+/// A file of the run as `run.json` records it, so that readers can tell it is the one this run
+/// wrote (`sha256sum FILE` shows the same digest).
+#[derive(Serialize)]
+struct FileRecord {
+    bytes: u64,
+    sha256: String,
+}
+
+/// The SHA-256 digest of `bytes` in hex.
+pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    sha2::Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The tables of a run, named as in its directory; `run.json` records their digests.
+pub const TABLES: [&str; 2] = ["lobes.csv", "summary.csv"];
+
+/// Files that `compare` derives from a run: a new run into the directory removes them.
+pub const DERIVED: [&str; 2] = ["models.csv", "compare.csv"];
+
 #[derive(Serialize)]
 struct RunReport<'a> {
     smithwalk_version: &'static str,
+    /// Identifies this run: the digest of its tables and the time it finished.
+    run_id: String,
+    /// `lobes.csv` and `summary.csv` as written, with their digests.
+    files: std::collections::BTreeMap<&'static str, FileRecord>,
     config: &'a Config,
     seed: u64,
     paths: u64,
@@ -335,13 +359,46 @@ struct RunReport<'a> {
     wall_seconds: f64,
     paths_per_second: f64,
     cases: Vec<CaseReport<'a>>,
+    /// The SHA-256 of this file's text with these 64 hex digits written as zeros
+    /// ([`SELF_DIGEST`]), so that a reader can tell any change to `run.json` itself.
+    self_sha256: String,
 }
 
-/// The JSON text of `run.json`: resolved config, version, seed, paths, timing, energy balance.
-pub fn run_json(sim: &Simulation, config: &Config) -> Result<Vec<u8>> {
+/// The key of `run.json`'s digest of itself, its last field.
+pub const SELF_DIGEST: &str = "\"self_sha256\": \"";
+
+/// The digest `run.json` text must carry: that of the text with its own digest as zeros.
+pub(crate) fn self_digest(text: &[u8]) -> Option<(std::ops::Range<usize>, String)> {
+    let key = SELF_DIGEST.as_bytes();
+    let start = text.windows(key.len()).rposition(|w| w == key)? + key.len();
+    let range = start..start + 64;
+    let mut zeroed = text.get(..range.end)?.to_vec();
+    zeroed[range.clone()].fill(b'0');
+    zeroed.extend_from_slice(&text[range.end..]);
+    Some((range, sha256_hex(&zeroed)))
+}
+
+/// The JSON text of `run.json`: resolved config, version, seed, paths, timing, energy balance,
+/// and the digests of the run's tables `tables` (the contents of [`TABLES`], in order).
+pub fn run_json(sim: &Simulation, config: &Config, tables: [&[u8]; 2]) -> Result<Vec<u8>> {
     let total = config.paths as f64 * sim.cases.len() as f64;
+    let files: std::collections::BTreeMap<_, _> = TABLES
+        .into_iter()
+        .zip(tables)
+        .map(|(name, bytes)| (name, FileRecord { bytes: bytes.len() as u64, sha256: sha256_hex(bytes) }))
+        .collect();
+    let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
+    let stamp = format!(
+        "{} {} {} {}",
+        files["lobes.csv"].sha256,
+        files["summary.csv"].sha256,
+        now.as_nanos(),
+        std::process::id()
+    );
     let report = RunReport {
         smithwalk_version: env!("CARGO_PKG_VERSION"),
+        run_id: sha256_hex(stamp.as_bytes())[..32].to_string(),
+        files,
         config,
         seed: config.seed,
         paths: config.paths,
@@ -355,15 +412,29 @@ pub fn run_json(sim: &Simulation, config: &Config) -> Result<Vec<u8>> {
             .zip(&sim.results)
             .map(|(case, r)| CaseReport { case, energy: EnergyBalance::from_result(r) })
             .collect(),
+        self_sha256: "0".repeat(64),
     };
     let mut text = serde_json::to_vec_pretty(&report)?;
     text.push(b'\n');
+    let (range, digest) = self_digest(&text).expect("run.json ends with its digest");
+    text[range].copy_from_slice(digest.as_bytes());
     Ok(text)
 }
 
-/// Writes `lobes.csv`, `summary.csv` and `run.json` of a simulation into `dir`, atomically.
+/// Writes `lobes.csv`, `summary.csv` and `run.json` of a simulation into `dir`, atomically,
+/// `run.json` last: it records the digests of the tables, so a run killed between the renames
+/// leaves tables that readers refuse ([`crate::io::rundir::RunDir::open`]) rather than a mix.
+/// The previous run's `models.csv` and `compare.csv` are removed first: they describe it.
 pub fn write_outputs(sim: &Simulation, config: &Config, dir: &Path) -> Result<Vec<PathBuf>> {
-    let files =
-        [("lobes.csv", lobes_csv(sim)?), ("summary.csv", summary_csv(sim)?), ("run.json", run_json(sim, config)?)];
-    write_atomically(dir, &files)
+    let (lobes, summary) = (lobes_csv(sim)?, summary_csv(sim)?);
+    let run = run_json(sim, config, [&lobes, &summary])?;
+    for stale in DERIVED {
+        match std::fs::remove_file(dir.join(stale)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(anyhow::Error::new(e).context(format!("cannot remove the previous run's {stale}")));
+            }
+            _ => {}
+        }
+    }
+    write_atomically(dir, &[(TABLES[0], lobes), (TABLES[1], summary), ("run.json", run)])
 }

@@ -1,6 +1,11 @@
 //! Reading a run directory back: the resolved config in `run.json` and the tables
 //! `lobes.csv`, `summary.csv` and (after `compare`) `models.csv`, for the commands that work
-//! on finished runs (`compare`, `plot`, `merl`).
+//! on finished runs (`compare`, `plot`, `merl`, `rgl`).
+//!
+//! A run directory is validated before any of it is used ([`RunDir::open`]): the tables must be
+//! the ones `run.json` records (SHA-256 digests: nothing changed them, and they belong to the
+//! same run), complete (every case, order slot, hemisphere, channel and bin exactly once) and
+//! finite, with non-negative energies. Otherwise the reader gets one error and writes nothing.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -8,20 +13,297 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use serde::Deserialize;
 
+use crate::atomic::{DirLock, lock_dir};
 use crate::engine::detector::Grid;
+use crate::io::output::{TABLES, self_digest, sha256_hex};
 use crate::setup::cases::Case;
 use crate::setup::config::Config;
 
-/// The resolved, validated config of a finished run, from its `run.json`.
+/// A CSV table of a run directory, read whole, with its columns found by name.
+pub(crate) struct Table {
+    pub path: PathBuf,
+    pub headers: csv::StringRecord,
+    pub records: Vec<csv::StringRecord>,
+}
+
+impl Table {
+    pub fn read(path: &Path) -> Result<Self> {
+        let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
+        let headers = reader.headers()?.clone();
+        let records = reader.records().collect::<Result<Vec<_>, _>>()?;
+        Ok(Self { path: path.to_path_buf(), headers, records })
+    }
+
+    pub fn column(&self, name: &str) -> Result<usize> {
+        self.headers
+            .iter()
+            .position(|h| h == name)
+            .with_context(|| format!("{}: no column {name}", self.path.display()))
+    }
+}
+
+/// The resolved, validated config of a finished run, from its `run.json`, once the whole run
+/// directory is validated ([`RunDir::open`]).
 pub fn read_config(run_dir: &Path) -> Result<Config> {
-    let run_json = run_dir.join("run.json");
-    let text = std::fs::read_to_string(&run_json).with_context(|| format!("cannot read {}", run_json.display()))?;
-    let json: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", run_json.display()))?;
-    let Some(config_json) = json.get("config") else { bail!("{}: no `config`", run_json.display()) };
-    let config: Config = serde_json::from_value(config_json.clone()).context("the run's config")?;
-    config.validate()?;
-    Ok(config)
+    Ok(RunDir::open(run_dir)?.config)
+}
+
+/// What `run.json` says of the run beyond its config.
+#[derive(Deserialize)]
+struct RunJson {
+    config: Config,
+    #[serde(default)]
+    files: Option<HashMap<String, FileRecord>>,
+    cases: Vec<CaseJson>,
+}
+
+#[derive(Deserialize)]
+struct FileRecord {
+    sha256: String,
+}
+
+#[derive(Deserialize)]
+struct CaseJson {
+    energy: EnergyJson,
+}
+
+#[derive(Deserialize)]
+struct EnergyJson {
+    highest_order: usize,
+}
+
+/// The shape of a run's tables: which rows `lobes.csv` and `summary.csv` must hold.
+struct Shape<'a> {
+    cases: &'a [Case],
+    /// Order slots per case.
+    slots: Vec<usize>,
+    channels: usize,
+    grid: Grid,
+}
+
+impl Shape<'_> {
+    fn hemispheres(&self, case: usize) -> usize {
+        if self.cases[case].material.transmits() { 2 } else { 1 }
+    }
+
+    /// The first row of each case in `table` when case `i` has `rows(hemispheres, slots)`
+    /// rows, and a mark per row, once the table is checked to have them all.
+    fn rows(&self, table: &Table, rows: impl Fn(usize, usize) -> usize) -> Result<(Vec<usize>, Vec<bool>)> {
+        let mut offsets = Vec::with_capacity(self.slots.len());
+        let mut total = 0usize;
+        for (i, &slots) in self.slots.iter().enumerate() {
+            offsets.push(total);
+            // Saturating: a forged run.json may claim any number of slots.
+            total = total.saturating_add(rows(self.hemispheres(i), slots));
+        }
+        if table.records.len() != total {
+            bail!("{} has {} rows, but the run in run.json has {total}", table.path.display(), table.records.len());
+        }
+        Ok((offsets, vec![false; total]))
+    }
+
+    /// The case of a row and its number of order slots.
+    fn case_of(&self, r: &csv::StringRecord, column: usize, at: &dyn Fn() -> String) -> Result<(usize, usize)> {
+        let case = index(r, column, "case", at)?;
+        let slots = self.slots.get(case).with_context(|| format!("{}: case {case} is not a case of the run", at()))?;
+        Ok((case, *slots))
+    }
+}
+
+/// `run.json` of `dir`, checked against the tables beside it.
+fn read_run_json(dir: &Path) -> Result<RunJson> {
+    let path = dir.join("run.json");
+    let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    match self_digest(text.as_bytes()) {
+        Some((range, digest)) if text.get(range.clone()) == Some(digest.as_str()) => {}
+        Some(_) => bail!("{} is corrupt: its self_sha256 does not match its content; rerun the config", path.display()),
+        None => bail!(
+            "{}: no self_sha256 (not written by this smithwalk, or written before run directories were sealed); \
+             rerun the config",
+            path.display()
+        ),
+    }
+    let run: RunJson = serde_json::from_str(&text)
+        .with_context(|| format!("{} is not the run.json of a finished smithwalk run", path.display()))?;
+    run.config.validate().with_context(|| format!("{}: the run's config", path.display()))?;
+    let Some(files) = &run.files else {
+        bail!(
+            "{}: no digests of the tables (written by a smithwalk before 0.1 with digests); rerun the config",
+            path.display()
+        )
+    };
+    for table in TABLES {
+        let file = dir.join(table);
+        let bytes = std::fs::read(&file).with_context(|| format!("cannot read {}", file.display()))?;
+        let recorded = files.get(table).with_context(|| format!("{}: no digest of {table}", path.display()))?;
+        if sha256_hex(&bytes) != recorded.sha256 {
+            bail!(
+                "{} is not the {table} that {} records (changed, damaged, or from an interrupted or other run); \
+                 rerun the config into this directory",
+                file.display(),
+                path.display()
+            );
+        }
+    }
+    Ok(run)
+}
+
+/// The value of column `column` of a row as a number that must be finite (and >= 0 if
+/// `non_negative`); `at` names the row in errors.
+fn number(
+    record: &csv::StringRecord,
+    column: usize,
+    name: &str,
+    non_negative: bool,
+    at: &dyn Fn() -> String,
+) -> Result<f64> {
+    let text = record.get(column).unwrap_or("");
+    let v: f64 = text.trim().parse().map_err(|_| anyhow::anyhow!("{}: {name} = {text:?} is not a number", at()))?;
+    if !v.is_finite() || (non_negative && v < 0.0) {
+        let allowed = if non_negative { "a finite number >= 0" } else { "a finite number" };
+        bail!("{}: {name} = {v} is not allowed: {allowed}", at());
+    }
+    Ok(v)
+}
+
+fn index(record: &csv::StringRecord, column: usize, name: &str, at: &dyn Fn() -> String) -> Result<usize> {
+    let text = record.get(column).unwrap_or("");
+    text.trim().parse().map_err(|_| anyhow::anyhow!("{}: {name} = {text:?} is not an index", at()))
+}
+
+/// Marks `key` (of `total`) as seen, refusing a duplicate.
+fn mark(seen: &mut [bool], key: usize, at: &dyn Fn() -> String) -> Result<()> {
+    let slot = seen.get_mut(key).with_context(|| format!("{}: not a row of this run", at()))?;
+    if std::mem::replace(slot, true) {
+        bail!("{}: the same row twice", at());
+    }
+    Ok(())
+}
+
+fn channel_of(
+    record: &csv::StringRecord,
+    column: Option<usize>,
+    channels: usize,
+    at: &dyn Fn() -> String,
+) -> Result<usize> {
+    match (column, channels) {
+        (None, 1) => Ok(0),
+        (Some(c), 3) => match record.get(c) {
+            Some("r") => Ok(0),
+            Some("g") => Ok(1),
+            Some("b") => Ok(2),
+            other => bail!("{}: channel = {other:?} is not r, g or b", at()),
+        },
+        _ => bail!("{}: the channel column does not fit a run with {channels} channel(s)", at()),
+    }
+}
+
+fn hemisphere_of(text: Option<&str>, hemispheres: usize, at: &dyn Fn() -> String) -> Result<usize> {
+    match (text, hemispheres) {
+        (Some("R"), _) => Ok(0),
+        (Some("T"), 2) => Ok(1),
+        (other, _) => bail!("{}: hemisphere = {other:?} is not one of this case's", at()),
+    }
+}
+
+/// Reports the first missing row of a table, if any.
+fn complete(seen: &[bool], path: &Path, describe: impl Fn(usize) -> String) -> Result<()> {
+    let missing = seen.iter().filter(|s| !**s).count();
+    if let Some(first) = seen.iter().position(|s| !*s) {
+        bail!(
+            "{} is incomplete: {missing} of {} rows missing (the first: {})",
+            path.display(),
+            seen.len(),
+            describe(first)
+        );
+    }
+    Ok(())
+}
+
+/// Checks that `lobes.csv` has every case, slot, hemisphere, channel and bin exactly once, with
+/// finite non-negative energies and BSDF values. Columns are found by name; others are allowed.
+fn check_lobes(path: &Path, shape: &Shape) -> Result<()> {
+    let table = Table::read(path)?;
+    let col = |name| table.column(name);
+    let (case_c, order_c, hemi_c) = (col("case")?, col("order")?, col("hemisphere")?);
+    let (cos_lo_c, cos_hi_c, phi_c) = (col("cos_lo")?, col("cos_hi")?, col("phi_lo_deg")?);
+    let values = ["energy", "energy_stderr", "bsdf", "bsdf_stderr"].map(|n| col(n).map(|c| (n, c)));
+    let channel_c = table.column("channel").ok();
+    let (grid, channels) = (shape.grid, shape.channels);
+    let (offsets, mut seen) =
+        shape.rows(&table, |hemispheres, slots| slots.saturating_mul(hemispheres * grid.bins() * channels))?;
+    for (line, r) in table.records.iter().enumerate() {
+        let at = || format!("{} line {}", path.display(), line + 2);
+        let (case, slots) = shape.case_of(r, case_c, &at)?;
+        let order = index(r, order_c, "order", &at)?;
+        if order >= slots {
+            bail!("{}: order {order} is not a slot of case {case} ({slots} slots)", at());
+        }
+        let hemispheres = shape.hemispheres(case);
+        let h = hemisphere_of(r.get(hemi_c), hemispheres, &at)?;
+        let c = channel_of(r, channel_c, channels, &at)?;
+        let (lo, hi, phi) = (
+            number(r, cos_lo_c, "cos_lo", false, &at)?,
+            number(r, cos_hi_c, "cos_hi", false, &at)?,
+            number(r, phi_c, "phi_lo_deg", false, &at)?,
+        );
+        let (ic, ip) = bin_of(grid, lo, hi, phi).with_context(|| format!("{}: a bin outside the run's grid", at()))?;
+        for v in &values {
+            let (name, column) = v.as_ref().map_err(|e| anyhow::anyhow!("{e}"))?;
+            number(r, *column, name, true, &at)?;
+        }
+        let key = offsets[case] + ((order * hemispheres + h) * grid.bins() + ic * grid.phi_bins + ip) * channels + c;
+        mark(&mut seen, key, &at)?;
+    }
+    complete(&seen, path, |k| format!("row {k} in the run's order"))
+}
+
+/// The bin `(cos index, phi index)` of a row, from the centre of its `|cos|` range and its
+/// lower phi edge.
+fn bin_of(grid: Grid, cos_lo: f64, cos_hi: f64, phi_lo_deg: f64) -> Option<(usize, usize)> {
+    let c = (0.5 * (cos_lo + cos_hi)).abs() * grid.cos_bins as f64;
+    let p = (phi_lo_deg / 360.0 * grid.phi_bins as f64).round();
+    let ok = |x: f64, n: usize| (0.0..n as f64).contains(&x);
+    (ok(c, grid.cos_bins) && ok(p, grid.phi_bins)).then_some((c as usize, p as usize))
+}
+
+/// Checks that `summary.csv` has every case's albedos (per slot, hemisphere and channel), its
+/// absorbed and lost energy exactly once, finite, and non-negative except the absorbed energy
+/// (an unbiased estimate of 1 - the escaped energy, which may dip below 0 by noise).
+fn check_summary(path: &Path, shape: &Shape) -> Result<()> {
+    let table = Table::read(path)?;
+    let col = |name| table.column(name);
+    let (case_c, order_c, hemi_c, paths_c) = (col("case")?, col("order")?, col("hemisphere")?, col("paths")?);
+    let (albedo_c, stderr_c) = (col("albedo")?, col("albedo_stderr")?);
+    let channel_c = table.column("channel").ok();
+    let channels = shape.channels;
+    // Per case: slots x hemispheres albedo rows, then absorbed and lost, each per channel.
+    let (offsets, mut seen) = shape.rows(&table, |hemispheres, slots| {
+        slots.saturating_mul(hemispheres).saturating_add(2).saturating_mul(channels)
+    })?;
+    for (line, r) in table.records.iter().enumerate() {
+        let at = || format!("{} line {}", path.display(), line + 2);
+        let (case, slots) = shape.case_of(r, case_c, &at)?;
+        let order = index(r, order_c, "order", &at)?;
+        let paths = index(r, paths_c, "paths", &at)?;
+        if paths < 2 {
+            bail!("{}: paths = {paths} is not allowed: at least 2", at());
+        }
+        let hemispheres = shape.hemispheres(case);
+        let c = channel_of(r, channel_c, channels, &at)?;
+        let what = r.get(hemi_c);
+        let row = match what {
+            Some("absorbed" | "lost") if order != 0 => bail!("{}: order {order} for {what:?}", at()),
+            Some("absorbed") => slots * hemispheres,
+            Some("lost") => slots * hemispheres + 1,
+            _ if order >= slots => bail!("{}: order {order} is not a slot of case {case} ({slots} slots)", at()),
+            _ => order * hemispheres + hemisphere_of(what, hemispheres, &at)?,
+        };
+        number(r, albedo_c, "albedo", what != Some("absorbed"), &at)?;
+        number(r, stderr_c, "albedo_stderr", true, &at)?;
+        mark(&mut seen, offsets[case] + row * channels + c, &at)?;
+    }
+    complete(&seen, path, |k| format!("row {k} in the run's order"))
 }
 
 /// One bin's value: energy per photon and BSDF (energy over projected solid angle), each
@@ -84,6 +366,10 @@ fn read_bins(path: &Path, grid: Grid) -> Result<HashMap<String, Lobes>> {
     let mut out: HashMap<String, Lobes> = HashMap::new();
     for row in reader.deserialize() {
         let row: BinRow = row.with_context(|| format!("{}: bad row", path.display()))?;
+        let values = [row.cos_lo, row.cos_hi, row.phi_lo_deg, row.energy, row.energy_stderr, row.bsdf];
+        if values.iter().chain(&row.bsdf_stderr).any(|v| !v.is_finite()) {
+            bail!("{}: a bin of case {} with a value that is not finite", path.display(), row.case);
+        }
         // |cos| of the bin's centre finds its cos index in either hemisphere.
         let ic = ((0.5 * (row.cos_lo + row.cos_hi)).abs() * grid.cos_bins as f64) as usize;
         let ip = (row.phi_lo_deg / 360.0 * grid.phi_bins as f64).round() as usize;
@@ -126,14 +412,35 @@ pub struct RunDir {
     pub config: Config,
     pub cases: Vec<Case>,
     pub grid: Grid,
+    /// Order slots of each case (the highest order with light, plus slot 0 for all orders).
+    pub slots: Vec<usize>,
+    /// A shared lock: no run writes into the directory while it is read.
+    _lock: DirLock,
 }
 
 impl RunDir {
+    /// Opens the run in `path` once it is validated: `run.json` records the digests of the
+    /// tables beside it, and the tables hold every row of its cases exactly once, finite, with
+    /// non-negative energies (see the module doc). Otherwise one error names what is wrong.
     pub fn open(path: &Path) -> Result<Self> {
-        let config = read_config(path)?;
+        let lock = lock_dir(path, false)?;
+        let run = read_run_json(path)?;
+        let config = run.config;
         let cases = crate::setup::cases::expand(&config);
+        if run.cases.len() != cases.len() {
+            bail!(
+                "{}: {} cases recorded, the config has {}",
+                path.join("run.json").display(),
+                run.cases.len(),
+                cases.len()
+            );
+        }
         let grid = Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins };
-        Ok(Self { path: path.to_path_buf(), config, cases, grid })
+        let slots: Vec<usize> = run.cases.iter().map(|c| c.energy.highest_order.saturating_add(1)).collect();
+        let shape = Shape { cases: &cases, slots: slots.clone(), channels: if config.is_rgb() { 3 } else { 1 }, grid };
+        check_lobes(&path.join(TABLES[0]), &shape)?;
+        check_summary(&path.join(TABLES[1]), &shape)?;
+        Ok(Self { path: path.to_path_buf(), config, cases, grid, slots, _lock: lock })
     }
 
     /// The measured lobes of `lobes.csv`.
@@ -148,6 +455,18 @@ impl RunDir {
             return Ok(HashMap::new());
         }
         read_bins(&path, self.grid)
+    }
+
+    /// For exports of reflection only: a one-line note of the transmission they drop (the
+    /// largest transmitted albedo of the run's cases), or `None` if no case transmits.
+    pub fn dropped_transmission(&self) -> Result<Option<String>> {
+        let transmitted = self.summary()?.into_iter().filter(|r| r.hemisphere == "T" && r.order == 0);
+        let Some(worst) = transmitted.max_by(|a, b| a.albedo.total_cmp(&b.albedo)) else { return Ok(None) };
+        Ok(Some(format!(
+            "note: the file holds reflection only; the run's transmission is dropped (up to {:.4} of the incident \
+             energy, case {})",
+            worst.albedo, worst.case
+        )))
     }
 
     /// The rows of `summary.csv`.

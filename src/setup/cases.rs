@@ -41,6 +41,27 @@ impl Case {
     }
 }
 
+/// The number of cases of a configuration, without expanding it (saturating: a validated
+/// config has at most [`crate::setup::config::MAX_CASES`]).
+pub fn count(config: &Config) -> u64 {
+    let s = &config.surface;
+    let i = &config.incident;
+    let thetas = i.theta_deg.as_ref().or(i.theta_rad.as_ref()).map_or(0, |t| t.as_slice().len());
+    [
+        s.ndf.as_slice().len(),
+        s.alpha.as_slice().len(),
+        s.height.as_slice().len(),
+        s.smith.as_slice().len(),
+        s.normals.as_slice().len(),
+        config.material.as_slice().len(),
+        i.side.as_slice().len(),
+        thetas,
+        i.phi_deg.as_slice().len(),
+    ]
+    .into_iter()
+    .fold(1u64, |n, len| n.saturating_mul(len as u64))
+}
+
 /// The cases of a configuration, in the order ndf, alpha, height, smith, normals, material,
 /// side, theta, phi (the last varies fastest). The index of a case is its position.
 pub fn expand(config: &Config) -> Vec<Case> {

@@ -8,14 +8,77 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-/// A field that takes one value or a list of values (a sweep). A list is tried first, so
+/// A field that takes one value or a list of values (a sweep). A list is a sweep, so
 /// `alpha = [0.5, 1.0]` is two isotropic roughnesses and one anisotropic roughness is written
 /// `[[0.5, 1.0]]`; it is always serialized as a list, so configs round-trip.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(untagged)]
+#[derive(Clone, Debug)]
 pub enum OneOrMany<T> {
     Many(Vec<T>),
     One(T),
+}
+
+/// Decides by the input's shape (a list or one value) and hands it to `T`, so that an error
+/// of `T` (an unknown variant, a missing field) reaches the user with its field and value
+/// instead of serde's "did not match any variant of untagged enum".
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for OneOrMany<T> {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::IntoDeserializer;
+        use serde::de::value::{MapAccessDeserializer, SeqAccessDeserializer};
+        struct Visitor<T>(std::marker::PhantomData<T>);
+        macro_rules! one {
+            ($($visit:ident: $t:ty),*) => {$(
+                fn $visit<E: serde::de::Error>(self, v: $t) -> Result<Self::Value, E> {
+                    T::deserialize(v.into_deserializer()).map(OneOrMany::One)
+                }
+            )*};
+        }
+        impl<'de, T: Deserialize<'de>> serde::de::Visitor<'de> for Visitor<T> {
+            type Value = OneOrMany<T>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("one value or a list of values")
+            }
+            one!(visit_bool: bool, visit_i64: i64, visit_u64: u64, visit_f64: f64, visit_str: &str);
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
+                Vec::<T>::deserialize(SeqAccessDeserializer::new(seq)).map(OneOrMany::Many)
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+                T::deserialize(MapAccessDeserializer::new(map)).map(OneOrMany::One)
+            }
+        }
+        d.deserialize_any(Visitor(std::marker::PhantomData))
+    }
+}
+
+/// Deserializes a number or a list of exactly `N` numbers (`what` says which, for errors).
+fn number_or_list<'de, D: serde::Deserializer<'de>, const N: usize>(
+    d: D,
+    what: &'static str,
+) -> Result<Result<f64, [f64; N]>, D::Error> {
+    struct Visitor<const N: usize>(&'static str);
+    impl<'de, const N: usize> serde::de::Visitor<'de> for Visitor<N> {
+        type Value = Result<f64, [f64; N]>;
+        fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+            f.write_str(self.0)
+        }
+        fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Self::Value, E> {
+            Ok(Ok(v))
+        }
+        fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Self::Value, E> {
+            Ok(Ok(v as f64))
+        }
+        fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Self::Value, E> {
+            Ok(Ok(v as f64))
+        }
+        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+            let mut values = Vec::new();
+            while let Some(v) = seq.next_element::<f64>()? {
+                values.push(v);
+            }
+            let n = values.len();
+            values.try_into().map(Err).map_err(|_| serde::de::Error::invalid_length(n, &self))
+        }
+    }
+    d.deserialize_any(Visitor::<N>(what))
 }
 
 impl<T: Serialize> Serialize for OneOrMany<T> {
@@ -47,11 +110,18 @@ impl<T: PartialEq> PartialEq for OneOrMany<T> {
 }
 
 /// A roughness entry: `0.5` (isotropic) or `[alpha_x, alpha_y]`.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum Alpha {
     Isotropic(f64),
     Anisotropic([f64; 2]),
+}
+
+impl<'de> Deserialize<'de> for Alpha {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let what = "a roughness alpha or an anisotropic pair [alpha_x, alpha_y]";
+        Ok(number_or_list::<D, 2>(d, what)?.map_or_else(Alpha::Anisotropic, Alpha::Isotropic))
+    }
 }
 
 impl Alpha {
@@ -64,11 +134,18 @@ impl Alpha {
 }
 
 /// A per-channel parameter: one value for all channels or `[r, g, b]`.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum Channels {
     Mono(f64),
     Rgb([f64; 3]),
+}
+
+impl<'de> Deserialize<'de> for Channels {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let what = "one value for all channels or three values [r, g, b]";
+        Ok(number_or_list::<D, 3>(d, what)?.map_or_else(Channels::Rgb, Channels::Mono))
+    }
 }
 
 impl Channels {
@@ -459,6 +536,18 @@ impl PrecisionConfig {
     }
 }
 
+/// The most photons per case.
+pub const MAX_PATHS: u64 = 1_000_000_000_000_000;
+
+/// The roughest surface a walk supports. A walk makes about `alpha` bounces (order 1152 at
+/// alpha 1e3, 105 770 at 1e5 at 60 deg, 64 photons): at 1e6, 14% of the energy passes the
+/// 2^20-interaction cap and is lost as runaway, so 1e4 keeps a factor of 100 to it (measured,
+/// docs/reliability.md).
+pub const MAX_ALPHA: f64 = 1e4;
+
+/// The most cases a sweep may expand to.
+pub const MAX_CASES: u64 = 1_000_000;
+
 fn default_seed() -> u64 {
     1
 }
@@ -492,8 +581,7 @@ impl Config {
 
     /// Parses and validates TOML text.
     pub fn parse(text: &str) -> Result<Self, ConfigError> {
-        let config: Config =
-            toml::from_str(text).map_err(|e| ConfigError::Parse { path: "<text>".into(), message: e.to_string() })?;
+        let config: Config = parse_toml(text)?;
         config.validate()?;
         Ok(config)
     }
@@ -502,6 +590,9 @@ impl Config {
     pub fn validate(&self) -> Result<(), ConfigError> {
         if self.paths < 2 {
             return Err(invalid("paths", self.paths, "at least 2 photons per case (standard errors need two)"));
+        }
+        if self.paths > MAX_PATHS {
+            return Err(invalid("paths", self.paths, "at most 10^15 photons per case (about 3 years at 10^7 paths/s)"));
         }
         let s = &self.surface;
         non_empty("surface.ndf", &s.ndf)?;
@@ -512,10 +603,23 @@ impl Config {
         for a in s.alpha.values() {
             let (x, y) = a.xy();
             for v in [x, y] {
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(invalid("surface.alpha", v, "a finite roughness > 0 (tested from 1e-3 to 3)"));
+                if !(v.is_finite() && v > 0.0 && v <= MAX_ALPHA) {
+                    return Err(invalid(
+                        "surface.alpha",
+                        v,
+                        "a roughness > 0 and at most 1e4: a walk makes about alpha bounces, and from alpha ~1e6 on walks \
+                         pass the 2^20-interaction cap and are lost (docs/reliability.md)",
+                    ));
                 }
             }
+        }
+        let cases = crate::setup::cases::count(self);
+        if cases > MAX_CASES {
+            return Err(invalid(
+                "the sweep (surface, material and incident lists)",
+                format!("{cases} cases"),
+                "at most 10^6 cases per run: split the sweep into several configs",
+            ));
         }
         let materials = self.material.values();
         if materials.is_empty() {
@@ -575,13 +679,24 @@ impl Config {
         }
         if let Some(p) = &self.precision {
             p.validate()?;
+            if let Some(k) = d.max_order
+                && p.orders > k as usize
+            {
+                return Err(invalid(
+                    "precision.orders",
+                    p.orders,
+                    format!("at most detector.max_order = {k} (order slots above {k} do not exist)"),
+                ));
+            }
         }
         if let Some(c) = &self.compare {
             for m in &c.models {
                 Model::parse(m).map_err(|allowed| invalid("compare.models", format!("{m:?}"), allowed))?;
             }
-            if c.paths.is_some_and(|p| p < 2) {
-                return Err(invalid("compare.paths", c.paths.unwrap_or(0), "at least 2 photons per case"));
+            if let Some(p) = c.paths
+                && !(2..=MAX_PATHS).contains(&p)
+            {
+                return Err(invalid("compare.paths", p, "from 2 to 10^15 photons per case"));
             }
         }
         let e = &self.energy;
@@ -599,6 +714,56 @@ impl Config {
     pub fn is_rgb(&self) -> bool {
         self.material.values().iter().any(MaterialConfig::is_rgb)
     }
+}
+
+/// Deserializes TOML text; an error is one line naming the field (its dotted path), the value
+/// as written (shortened) and what is allowed, whatever the input's size.
+pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, ConfigError> {
+    let parse = |message: String| ConfigError::Parse { path: "<text>".into(), message };
+    let at = |e: &toml::de::Error| {
+        e.span().map_or(String::new(), |s| {
+            let line = text[..s.start.min(text.len())].matches('\n').count() + 1;
+            format!(" (line {line})")
+        })
+    };
+    let deserializer = toml::de::Deserializer::parse(text)
+        .map_err(|e| parse(format!("not TOML{}: {}", at(&e), shorten(e.message(), MESSAGE_CHARS))))?;
+    serde_path_to_error::deserialize(deserializer).map_err(|e| {
+        let field = e.path().to_string();
+        let inner = e.inner();
+        let value = inner.span().and_then(|s| text.get(s)).map_or("?".to_string(), |v| shorten(v, VALUE_CHARS));
+        let allowed = shorten(inner.message(), MESSAGE_CHARS);
+        // Keys inside a material (a table tagged by `kind`) are not on serde's path.
+        let key = |prefix: &str| inner.message().strip_prefix(prefix).and_then(|m| m.split('`').next());
+        let line = at(inner);
+        match (key("unknown field `"), key("missing field `")) {
+            (Some(k), _) => {
+                let field = if field.ends_with(k) { field } else { format!("{field}.{k}") };
+                parse(format!("`{field}` is not a known key{line}: {allowed}"))
+            }
+            (None, Some(k)) => {
+                parse(format!("`{}` is missing{line}: {allowed}", format!("{field}.{k}").trim_start_matches(".")))
+            }
+            _ if field == "." => parse(format!("{allowed}{line}")),
+            _ => parse(format!("`{field}` = {value} is not allowed{line}: {allowed}")),
+        }
+    })
+}
+
+/// Longest quoted value and message in a config error.
+const VALUE_CHARS: usize = 60;
+const MESSAGE_CHARS: usize = 300;
+
+/// `text` on one line (runs of whitespace as one space), cut in the middle to at most `max`
+/// characters: long inputs are quoted shortened, never echoed whole.
+pub fn shorten(text: &str, max: usize) -> String {
+    let one_line = |s: &str| s.split_whitespace().collect::<Vec<_>>().join(" ");
+    if text.chars().nth(max).is_none() {
+        return one_line(text);
+    }
+    let head: String = text.chars().take(max / 2).collect();
+    let tail: String = text.chars().rev().take(max / 2).collect::<Vec<_>>().into_iter().rev().collect();
+    format!("{} … {} ({} bytes)", one_line(&head), one_line(&tail), text.len())
 }
 
 fn non_empty<T: Clone>(field: &str, v: &OneOrMany<T>) -> Result<(), ConfigError> {

@@ -1,0 +1,114 @@
+//! Every bad config gets one line naming the field, the value as written and what is allowed
+//! (never serde's "did not match any variant of untagged enum"); long inputs are quoted
+//! shortened; configs beyond the documented limits (photons, roughness, threads, memory) are
+//! refused before any work, with nothing written.
+
+use std::process::Command;
+
+use smithwalk::setup::config::Config;
+
+const BASE: &str =
+    "paths = 1000\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 30\n";
+
+fn error_of(toml: &str) -> String {
+    match Config::parse(toml) {
+        Ok(_) => panic!("accepted:\n{toml}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn every_bad_config_names_its_field_value_and_what_is_allowed() {
+    let with = |from: &str, to: &str| BASE.replace(from, to);
+    let cases = [
+        (
+            with("alpha = 0.5", "alpha = 0.5\nndf = \"gaussian\""),
+            ["`surface.ndf` = \"gaussian\"", "`ggx` or `beckmann`"],
+        ),
+        (with("\"conductor\"", "\"metal\""), ["`material.kind` = \"metal\"", "`dielectric`"]),
+        (with("theta_deg = 30", "theta_deg = 30\nside = \"bottom\""), ["`incident.side` = \"bottom\"", "`inside`"]),
+        (with("alpha = 0.5", "alpha = 0.5\nsmith = \"Exact\""), ["`surface.smith` = \"Exact\"", "`exact`"]),
+        (with("alpha = 0.5", "alpha = 0.5\nnormals = \"foo\""), ["`surface.normals` = \"foo\"", "`vndf`"]),
+        (with("\"conductor\"", "\"conductor\"\ncolor = 3"), ["`material.color` is not a known key", "`fresnel`"]),
+        (with("\"conductor\"", "\"dielectric\""), ["`material.eta` is missing", "missing field `eta`"]),
+        (with("\"conductor\"", "\"diffuse\"\nalbedo = [0.5, 0.5]"), ["`material`", "three values [r, g, b]"]),
+        (
+            with("alpha = 0.5", "alpha = [[0.1, 0.2, 0.3]]"),
+            ["`surface.alpha[0]` = [0.1, 0.2, 0.3]", "[alpha_x, alpha_y]"],
+        ),
+        (with("alpha = 0.5", "alpha = 1e5"), ["`surface.alpha` = 100000", "> 0 and at most 1e4"]),
+        (with("paths = 1000", "paths = 1_000_000_000_000_001"), ["`paths` = 1000000000000001", "at most 10^15"]),
+        (
+            format!("{BASE}[detector]\nmax_order = 4\n[precision]\ntarget_rel_stderr = 0.01\norders = 1000\n"),
+            ["`precision.orders` = 1000", "detector.max_order = 4"],
+        ),
+        (
+            with("theta_deg = 30", "theta_deg = 30\nphi_deg = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9]\nside = [\"outside\"]"),
+            ["", ""],
+        ),
+    ];
+    for (toml, fragments) in &cases[..cases.len() - 1] {
+        let e = error_of(toml);
+        assert!(!e.contains("untagged") && !e.contains('\n'), "{e}");
+        for f in fragments {
+            assert!(e.contains(f), "{e:?} lacks {f:?}");
+        }
+    }
+    Config::parse(&cases[cases.len() - 1].0).expect("a valid sweep");
+}
+
+#[test]
+fn a_huge_sweep_is_refused_before_it_is_expanded() {
+    let thetas: Vec<String> = (0..1000).map(|i| format!("{}", i as f64 * 0.09)).collect();
+    let phis: Vec<String> = (0..1001).map(|i| i.to_string()).collect();
+    let toml =
+        BASE.replace("theta_deg = 30", &format!("theta_deg = [{}]\nphi_deg = [{}]", thetas.join(","), phis.join(",")));
+    let e = error_of(&toml);
+    assert!(e.contains("1001000 cases") && e.contains("at most 10^6"), "{e}");
+}
+
+#[test]
+fn a_50_mb_line_is_quoted_shortened() {
+    let junk = "x".repeat(50_000_000);
+    for toml in [junk.clone(), format!("paths = \"{junk}\"\n"), BASE.replace("\"conductor\"", &format!("\"{junk}\""))] {
+        let e = error_of(&toml);
+        assert!(e.len() < 1000 && !e.contains('\n'), "{} bytes: {}", e.len(), &e[..e.len().min(300)]);
+    }
+}
+
+/// Runs the binary on `config` (written to a temporary file) with `args`; returns the exit
+/// code and stderr, and checks that the output directory was not created.
+fn run(config: &str, args: &[&str]) -> (Option<i32>, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("c.toml");
+    std::fs::write(&path, config).unwrap();
+    let out_dir = dir.path().join("out");
+    let out = Command::new(env!("CARGO_BIN_EXE_smithwalk"))
+        .args(["run", path.to_str().unwrap(), "--out", out_dir.to_str().unwrap()])
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(!out_dir.exists(), "{args:?}: an output directory was made");
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+#[test]
+fn limits_are_checked_before_any_work() {
+    // Once a loop over every chunk of 10^19 photons, and minutes of spawning threads.
+    let (code, e) = run(BASE, &["--paths", "10000000000000000000"]);
+    assert_eq!(code, Some(1));
+    assert!(e.contains("`paths` = 10000000000000000000") && e.contains("10^15"), "{e}");
+    let (code, e) = run(BASE, &["--threads", "100000"]);
+    assert_eq!(code, Some(1));
+    assert!(e.contains("`--threads` = 100000") && e.contains("at most 1024"), "{e}");
+    // 4096 x 4096 bins (the grid's maximum) over 24 cases: ~10^3 GB of tallies, once an abort
+    // on a failed allocation.
+    let big = BASE
+        .replace("theta_deg = 30", "theta_deg = [0, 10, 20, 30, 40, 50, 60, 70, 80, 85, 88, 89]")
+        .replace("alpha = 0.5", "alpha = [0.5, 1.0]")
+        + "[detector]\ncos_theta_bins = 4096\nphi_bins = 4096\n";
+    let (code, e) = run(&big, &["--threads", "1"]);
+    assert_eq!(code, Some(1));
+    assert!(e.contains("detector.cos_theta_bins") && e.contains("detector.max_order") && e.contains("GB"), "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+}
