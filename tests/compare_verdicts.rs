@@ -16,6 +16,7 @@
 //!   lobes (the quadrature with a tolerance of 0.05 of each bin's standard error and a bound on
 //!   evaluations; before issue 16.5 these did not finish in 100 s).
 
+use sha2::{Digest, Sha256};
 use std::collections::HashSet;
 use std::path::Path;
 use std::process::{Command, Output};
@@ -134,6 +135,9 @@ fn a_wrong_measurement_is_rejected_and_fails_the_gate() {
         }
         std::fs::write(&path, writer.into_inner().unwrap()).unwrap();
     }
+    // Seal the wrong tables as a build of smithwalk with this bug would: run.json's digests
+    // then match, and the run directory is accepted.
+    reseal(Path::new(&out));
     let bad = gate(&out);
     let report = String::from_utf8_lossy(&bad.stdout);
     assert_eq!(bad.status.code(), Some(3), "{report}");
@@ -185,4 +189,20 @@ fn single_scattering_terminates_and_accepts_the_walk_at_tiny_roughness() {
             assert!(p > level, "alpha {alpha}, theta {theta}: p = {p}\n{report}");
         }
     }
+}
+
+/// Rewrites `run.json` of `dir` with the size and SHA-256 of its present `lobes.csv` and
+/// `summary.csv`, and its own digest (the SHA-256 of its text with that digest zeroed).
+fn reseal(dir: &Path) {
+    let hex = |bytes: &[u8]| Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect::<String>();
+    let path = dir.join("run.json");
+    let mut run: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    for table in ["lobes.csv", "summary.csv"] {
+        let bytes = std::fs::read(dir.join(table)).unwrap();
+        run["files"][table] = serde_json::json!({ "bytes": bytes.len(), "sha256": hex(&bytes) });
+    }
+    let zeros = "0".repeat(64);
+    run["self_sha256"] = serde_json::Value::String(zeros.clone());
+    let text = serde_json::to_string_pretty(&run).unwrap() + "\n";
+    std::fs::write(&path, text.replace(&zeros, &hex(text.as_bytes()))).unwrap();
 }

@@ -85,9 +85,10 @@ fn the_report_takes_family_level_and_rejections_from_compare_csv_when_present() 
     smithwalk::analysis::compare::compare(dir.path(), &[Model::Single], Some(20000), Some(2)).unwrap();
     plot(dir.path(), &PlotOptions::default()).unwrap();
     let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
-    // 8 cases, order 1, R for all and T for the 4 dielectric ones: 12 lobes; Sidak at 0.01.
+    // 8 cases, order 1, R for all and T for the 4 dielectric ones: 12 lobes; family level 0.01,
+    // Sidak per lobe.
     let level = 1.0 - 0.99_f64.powf(1.0 / 12.0);
-    let row = format!("<tr><td>single</td><td>12</td><td>{level:.2e}</td>");
+    let row = format!("<tr><td>single</td><td>12</td><td>0.01</td><td>{level:.2e}</td>");
     assert!(html.contains(&row), "{row} not in the report");
 
     // The same table with the columns another version of compare writes, in another order.
@@ -101,7 +102,8 @@ fn the_report_takes_family_level_and_rejections_from_compare_csv_when_present() 
     std::fs::write(&path, out).unwrap();
     plot(dir.path(), &PlotOptions::default()).unwrap();
     let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
-    assert!(html.contains("<tr><td>single</td><td>12</td><td>5.00e-1</td><td>1</td>"), "{html}");
+    let row = format!("<tr><td>single</td><td>12</td><td>0.5</td><td>{level:.2e}</td><td>1</td>");
+    assert!(html.contains(&row), "{html}");
     assert!(html.contains("rejected in 1 lobes"));
 }
 

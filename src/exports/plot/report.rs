@@ -63,6 +63,7 @@ struct Comparison {
     albedo_diff_se: f64,
     folded: Option<bool>,
     family_level: Option<f64>,
+    lobe_level: Option<f64>,
     rejected: Option<bool>,
 }
 
@@ -77,8 +78,13 @@ fn read_comparisons(run_dir: &Path) -> Result<Option<Vec<Comparison>>> {
     let (case, model, order, hemisphere) = (column("case")?, column("model")?, column("order")?, column("hemisphere")?);
     let (chi2, dof, p, rel_l1, diff) =
         (column("chi2")?, column("dof")?, column("p_value")?, column("rel_l1")?, column("albedo_diff_se")?);
-    let (channel, folded, level, rejected) =
-        (optional("channel"), optional("folded"), optional("family_level"), optional("rejected"));
+    let (channel, folded, level, lobe_level, rejected) = (
+        optional("channel"),
+        optional("folded"),
+        optional("family_level"),
+        optional("lobe_level"),
+        optional("rejected"),
+    );
     let number = |r: &csv::StringRecord, c: usize| -> Result<f64> {
         r[c].parse().map_err(|_| {
             anyhow::anyhow!("{}: `{}` in column {} is not a number", path.display(), &r[c], &table.headers[c])
@@ -102,6 +108,7 @@ fn read_comparisons(run_dir: &Path) -> Result<Option<Vec<Comparison>>> {
                 albedo_diff_se: number(r, diff)?,
                 folded: flag(r, folded),
                 family_level: level.map(|c| number(r, c)).transpose()?,
+                lobe_level: lobe_level.map(|c| number(r, c)).transpose()?,
                 rejected: flag(r, rejected),
             })
         })
@@ -109,9 +116,10 @@ fn read_comparisons(run_dir: &Path) -> Result<Option<Vec<Comparison>>> {
         .map(Some)
 }
 
-/// Per model: the number of lobes, the family level, how many lobes it rejects, and the worst
-/// lobes. `family_level` and `rejected` come from `compare.csv` when it has them; otherwise
-/// they are computed here: Sidak at family level 0.01 over the model's lobes.
+/// Per model: the number of lobes, the family level, the per-lobe level, how many lobes it
+/// rejects, and the worst lobes. `family_level`, `lobe_level` and `rejected` come from
+/// `compare.csv` when it has them; otherwise they are computed here: Sidak at family level 0.01
+/// over the model's lobes.
 fn comparison_tables(html: &mut String, run: &RunDir, rows: &[Comparison]) {
     let mut by_model: BTreeMap<&str, Vec<&Comparison>> = BTreeMap::new();
     for row in rows {
@@ -123,17 +131,18 @@ fn comparison_tables(html: &mut String, run: &RunDir, rows: &[Comparison]) {
          model's lobes so that a right model is rejected anywhere with probability 0.01. <code>rel L1</code>: the lobe \
          difference relative to the model's L1 norm; <code>albedo diff</code>: measured minus model albedo in combined \
          standard errors.</p>\n<table class=\"compare\"><tr><th>model</th><th>lobes</th><th>family level</th>\
-         <th>rejected</th><th>worst p</th><th>verdict</th></tr>\n",
+         <th>per-lobe level</th><th>rejected</th><th>worst p</th><th>verdict</th></tr>\n",
     );
     for (model, lobes) in &by_model {
-        let level = lobes.iter().find_map(|c| c.family_level).unwrap_or_else(|| sidak(FAMILY_LEVEL, lobes.len()));
+        let family = lobes.iter().find_map(|c| c.family_level).unwrap_or(FAMILY_LEVEL);
+        let level = lobes.iter().find_map(|c| c.lobe_level).unwrap_or_else(|| sidak(family, lobes.len()));
         let rejected = lobes.iter().filter(|c| c.rejected.unwrap_or(c.p < level)).count();
         let worst = lobes.iter().map(|c| c.p).fold(f64::INFINITY, f64::min);
         let verdict =
             if rejected == 0 { "agrees with the walk".to_string() } else { format!("rejected in {rejected} lobes") };
         let _ = writeln!(
             html,
-            "<tr><td>{}</td><td>{}</td><td>{level:.2e}</td><td>{rejected}</td><td>{}</td><td class=\"{}\">{verdict}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td>{family}</td><td>{level:.2e}</td><td>{rejected}</td><td>{}</td><td class=\"{}\">{verdict}</td></tr>",
             escape(model),
             lobes.len(),
             p_text(worst),
