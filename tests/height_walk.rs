@@ -111,7 +111,7 @@ fn reference_photon<N: Ndf, F: Facet<1>, O: Observer<1>>(
             break;
         }
         h = law.c1_inv(u);
-        if !(u > 0.0) || h.is_nan() {
+        if u.is_nan() || u <= 0.0 || h.is_nan() {
             observer.lose(Loss::Trapped, &[weight]);
             break;
         }
