@@ -1,10 +1,14 @@
 //! Energy conservation and per-order reference values (docs/theory.md §9.2, §9.4).
 //!
-//! * White furnace: conductor F = 1, Lambertian albedo 1 and dielectric R + T, GGX and
-//!   Beckmann, alpha in {0.1, 0.5, 1, 2}, isotropic and anisotropic, theta_i in {0, 60, 89} deg,
-//!   20 000 photons each. Every photon must be accounted for: the absorbed energy is within 4
-//!   standard errors of 0 (for F = 1 and albedo 1 the SE is 0 and the balance must be exact),
-//!   and no weight is lost to trapping, NaN or runaway.
+//! * White furnace (bookkeeping only): conductor F = 1, Lambertian albedo 1 and dielectric
+//!   R + T, GGX and Beckmann, alpha in {0.1, 0.5, 1, 2}, isotropic and anisotropic, theta_i in
+//!   {0, 60, 89} deg, 20 000 photons each. Every photon must be accounted for: the absorbed
+//!   energy is within 4 standard errors of 0 (for F = 1 and albedo 1 the SE is 0 and the
+//!   balance must be exact), and no weight is lost to trapping, NaN or runaway. With F = 1
+//!   and albedo 1 every path keeps weight 1, so R = 1 whatever Lambda, D, the sampler or the
+//!   exit directions do: only a loss (trapping, NaN, runaway, a dropped branch) fails it. The
+//!   tests that depend on Lambda, D and the sampler are the per-order albedos below (and
+//!   single_scattering.rs, height_walk.rs, phase_normalization.rs).
 //! * Per-order albedos against the independent random-walk and quadrature tables of §9.4
 //!   (conductor: 2e6 photons, SE <= 4e-4; Lambertian and dielectric: 1e6 photons), within 4
 //!   combined standard errors (ours, the table's binomial SE, and its 4-decimal rounding).
@@ -16,7 +20,7 @@ use smithwalk::engine::detector::Hemisphere;
 use smithwalk::io::output::EnergyBalance;
 
 #[test]
-fn white_furnace() {
+fn bookkeeping_white_furnace_loses_no_weight() {
     let materials = [
         "[[material]]\nkind = \"conductor\"",
         "[[material]]\nkind = \"diffuse\"\nalbedo = 1.0",
@@ -51,7 +55,10 @@ fn white_furnace() {
 
 #[test]
 fn conductor_per_order_albedos() {
-    // §9.4: conductor F = 1, isotropic GGX, uniform heights; E1..E6.
+    // §9.4: conductor F = 1, isotropic GGX, uniform heights; E1..E6. Unlike the furnace, these
+    // depend on Lambda (how deep the first hit is, how likely each escape), on D and on the
+    // visible-normal sampler (which directions follow): a 2% error in Lambda or a 3% stretch
+    // in the sampler moves E1 or E2 by many standard errors.
     for (i, (alpha, theta, row)) in CONDUCTOR_ORDERS.into_iter().enumerate() {
         let toml = format!(
             "paths = 2_000_000\nseed = {}\n[surface]\nalpha = {alpha}\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 8\n",
@@ -126,8 +133,23 @@ fn dielectric_reflection_and_transmission() {
 
 #[test]
 fn constant_fresnel_and_albedo_scale_each_order() {
-    // §9.1 scaling: with Schlick F0 = 1 everywhere F = 1; with diffuse albedo rho, f_k scales as
-    // rho^k. Same seed, so rho = 0.5 without roulette reweights the same paths exactly.
+    // §9.1 scaling, same seed, no roulette, so the same paths are reweighted exactly:
+    // * Schlick with F0 = 1 is F = 1 at every angle: the conductor's per-order albedos equal
+    //   those of `fresnel = "none"` (to rounding); a Schlick factor that is not exactly 1 at
+    //   F0 = 1 (a wrong exponent sign, F0 and 1 - F0 swapped) breaks it;
+    // * with diffuse albedo rho, f_k scales as rho^k.
+    let conductor = |fresnel: &str| {
+        let toml = format!(
+            "paths = 100_000\nseed = 7\n[surface]\nalpha = 0.7\n[material]\nkind = \"conductor\"\n{fresnel}\n[incident]\ntheta_deg = 40\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 5\n[energy]\nsplit = false\nthreshold = 0.0\n"
+        );
+        simulate(&toml, 1)
+    };
+    let (white, schlick) = (conductor("fresnel = \"none\""), conductor("fresnel = \"schlick\"\nf0 = 1.0"));
+    for k in 1..5 {
+        let (a, _) = albedo(mono(&white, 0), k, Hemisphere::R);
+        let (b, _) = albedo(mono(&schlick, 0), k, Hemisphere::R);
+        assert!(a > 0.0 && (b - a).abs() < 1e-12, "order {k}: Schlick F0 = 1 gives {b}, F = 1 gives {a}");
+    }
     let run = |albedo: f64| {
         let toml = format!(
             "paths = 100_000\nseed = 8\n[surface]\nalpha = 0.7\n[material]\nkind = \"diffuse\"\nalbedo = {albedo}\n[incident]\ntheta_deg = 40\n[detector]\ncos_theta_bins = 1\nphi_bins = 1\nmax_order = 5\n[energy]\nsplit = false\nthreshold = 0.0\n"
@@ -208,12 +230,26 @@ albedo = 1.0
 [incident]
 theta_deg = [0, 89.99]
 "#;
+    // Where the balance is known exactly, it is checked exactly: Lambertian and Hammon facets
+    // of albedo 1 absorb nothing (Hammon's branches carry F and 1 - F), so R = 1 within 4 SE
+    // of the absorbed energy (0 when every path keeps weight 1) plus rounding; the Schlick
+    // conductor with F0 < 1 absorbs (R < 1 - 4 SE) and R grows with F0.
     let sim = simulate(others, 2);
     for (case, result) in sim.cases.iter().zip(&sim.results) {
         let e = EnergyBalance::from_result(result);
-        assert_eq!(e.lost(), 0.0, "{}: {e:?}", case.material.label());
-        for c in 0..3 {
-            assert!(e.reflected[c].is_finite() && (0.0..=1.0 + 4.0 * e.absorbed_stderr[c]).contains(&e.reflected[c]));
+        let label = format!("{:?} ({}) {} {}", case.ndf, case.alpha_x, case.material.label(), case.theta_i_deg);
+        assert_eq!(e.lost(), 0.0, "{label}: {e:?}");
+        for c in 0..e.reflected.len() {
+            let (r, se) = (e.reflected[c], e.absorbed_stderr[c]);
+            assert!(r.is_finite() && e.transmitted[c] == 0.0, "{label} channel {c}: {e:?}");
+            if case.material.label().contains("conductor") {
+                assert!(r > 0.0 && r < 1.0 - 4.0 * se, "{label} channel {c}: R = {r} +- {se}");
+            } else {
+                assert!((r - 1.0).abs() <= 4.0 * se + 1e-12, "{label} channel {c}: R = {r} +- {se}, lossless facet");
+            }
+        }
+        if case.material.label().contains("conductor") {
+            assert!(e.reflected[0] > e.reflected[1] && e.reflected[1] > e.reflected[2], "{label}: R follows F0 {e:?}");
         }
     }
 }

@@ -132,7 +132,10 @@ fn fresnel_reference_values() {
 #[test]
 fn hammon_exit_lobe() {
     // §4.5: k = 21/(20 pi) normalizes the exit lobe: 2 pi k ∫ (1 - (1-c)^5) c dc = 1, and Y is
-    // its CDF. E[c] = 0.6875 (exact rational: 11/16).
+    // its CDF. E[c] = 0.6875 (exact rational: 11/16). This checks the closed form of k and the
+    // sampler's CDF; the constants where they are used are checked elsewhere: the facet's
+    // (`Facet::phase`) in phase_normalization.rs, models.rs's by the order-1 chi-square of
+    // Hammon facets in single_scattering.rs (the walk samples the exit by this CDF, not by k).
     let k = 21.0 / (20.0 * PI);
     let pdf = |c: f64| TAU * k * (1.0 - (1.0 - c).powi(5)) * c;
     assert!((integrate(pdf, 0.0, 1.0, 1e-14).0 - 1.0).abs() < 1e-12);

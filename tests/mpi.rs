@@ -2,8 +2,10 @@
 //! smithwalk run CONFIG` writes tables bit-identical to the plain run's, for any N, also when
 //! every process is killed with SIGKILL and the job is run again with `--resume`.
 //!
-//! `cargo test --release --features mpi --test mpi` (as `.ci/run` does, as root).
-#![cfg(feature = "mpi")]
+//! `cargo test --release --features mpi --test mpi` (as `.ci/run` does, as root). Cargo.toml
+//! gives this target `required-features = ["mpi"]`: without the feature cargo does not build
+//! it at all (rather than compiling it to zero tests that look like a pass), and
+//! `--test mpi` alone says the feature is required.
 
 mod common;
 

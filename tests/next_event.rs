@@ -1,6 +1,13 @@
 //! Next-event estimation (Heitz et al. 2016 `eval`, docs/theory.md §4.7) against the escape
-//! histogram: two independent estimators of the same bin integrals, order by order. This is
-//! the exact oracle for orders >= 2.
+//! histogram: two estimators of the same bin integrals, order by order.
+//!
+//! What this checks, honestly: the depth and escape part of the walk (where hits happen and
+//! whether light leaves), for every order. It is not an independent oracle of the facets or
+//! the sampler: both estimators draw the hit normals with `Normals::sample` and the outgoing
+//! directions with `Facet::interact`, so a wrong visible-normal sampler or a wrong facet
+//! passes it. Those are checked by single_scattering.rs, visible_normals.rs, slope_space.rs,
+//! phase_normalization.rs and inside_single_scattering.rs, and whole walks against
+//! independent per-order tables (energy.rs) and a height-form walk (height_walk.rs).
 //!
 //! Seven cases (GGX conductor F = 1 and exact Fresnel anisotropic at 70 deg, dielectric from
 //! outside and from inside, Lambertian and Hammon facets, Beckmann anisotropic with exact

@@ -1,6 +1,11 @@
 //! The exact position-free form (docs/theory.md §7.1): the walk with its collision depths
 //! integrated out, run on the height-free chain.
 //!
+//! What the lobe comparison checks: the depth process of the walk (free flights, escapes),
+//! against its analytic integral. The chain draws its directions with the walk's own
+//! `Ndf::sample_visible` and `Facet::interact`, so a sampler or facet bug shared by both
+//! passes that part; the per-order albedos against docs/theory.md §9.4's table do not share them.
+//!
 //! * The depth profile against closed forms of §6.3 and §7.1 (one and two bounces, the
 //!   down-up-down-up pattern of §7.3, equal rates), and against a direct simulation of the
 //!   depth process for a longer pattern (10^6 samples, within 4 SE).

@@ -3,6 +3,11 @@
 //! walk (docs/theory.md §4) with the random numbers drawn in another order, so the two must
 //! measure the same lobes.
 //!
+//! An equivalence test, not an oracle: both walks share the flights, `Normals::sample` and
+//! `Facet::interact`, so physics wrong in those passes it. It catches what differs between
+//! the two walks: the lanes, the refill of escaped photons from the excess variate, the
+//! buffering of escapes and the order of the random draws.
+//!
 //! Seven cases cover every part of a lane's step: GGX and anisotropic Beckmann conductors
 //! (F = 1 and Schlick with absorption and roulette), Lambertian facets, a dielectric and
 //! Hammon's facet with their two branches chosen at random (split off), Hammon's rejection
