@@ -166,7 +166,7 @@ fn bins_for<N: Ndf>(ndf: &N, case: &Case, grid: &Grid, hemisphere: Hemisphere, a
 
 /// How a lobe is integrated over a bin.
 #[derive(Clone, Copy, Debug)]
-enum BinRule {
+pub(crate) enum BinRule {
     /// Adaptive Gauss–Kronrod to this absolute tolerance.
     Adaptive(f64),
     /// A fixed `n x n` Gauss–Legendre product rule.
@@ -175,7 +175,7 @@ enum BinRule {
 
 /// Integrates a cosine-weighted lobe `wo -> f(wi, wo) |cos theta_o|` over every bin of
 /// `hemisphere` (index `cos * phi_bins + phi`; phi from the incident azimuth).
-fn integrate_bins(
+pub(crate) fn integrate_bins(
     case: &Case,
     grid: &Grid,
     hemisphere: Hemisphere,
