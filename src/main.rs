@@ -72,7 +72,7 @@ enum Command {
         /// The run's output directory (with run.json, lobes.csv and summary.csv).
         run_dir: PathBuf,
         /// Comma-separated models: single, hammon-fit, heitz-nee, exact-position-free,
-        /// wang-correlated, wang-uncorrelated.
+        /// wang-correlated, wang-uncorrelated, kulla-conty, turquin, fdez-aguera.
         #[arg(
             long,
             value_delimiter = ',',
@@ -86,6 +86,10 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
+        /// A user's own model in the run's bins (CSV: case, order, hemisphere, [channel], cos_lo,
+        /// cos_hi, phi_lo_deg, phi_hi_deg, energy, [energy_stderr]), judged as `external`.
+        #[arg(long)]
+        external: Option<PathBuf>,
     },
     /// Draw a run's lobes (plane of incidence per order with the models of models.csv, polar
     /// heat maps) and per-order albedos as PNG files, with an index.html, into the run directory.
@@ -298,7 +302,7 @@ fn finish_run(
     if let Some(c) = &config.compare {
         let models =
             c.models.iter().map(|m| Model::parse(m).map_err(anyhow::Error::msg)).collect::<Result<Vec<_>>>()?;
-        print!("{}", smithwalk::analysis::compare::compare(out, &models, c.paths, threads)?);
+        print!("{}", smithwalk::analysis::compare::compare(out, &models, c.paths, threads, None)?);
     }
     Ok(())
 }
@@ -438,8 +442,9 @@ fn main() -> ExitCode {
             run(RunArgs { config, paths, seed, threads, out, shard, resume, checkpoint_seconds })
         }
         Command::Merge { shards, out } => merge(&shards, &out),
-        Command::Compare { run_dir, models, paths, threads } => {
-            smithwalk::analysis::compare::compare(&run_dir, &models, paths, threads).map(|report| print!("{report}"))
+        Command::Compare { run_dir, models, paths, threads, external } => {
+            smithwalk::analysis::compare::compare(&run_dir, &models, paths, threads, external.as_deref())
+                .map(|report| print!("{report}"))
         }
         Command::Lut { config, paths, threads, out } => lut(&config, paths, threads, out),
         Command::Plot { run_dir } => smithwalk::exports::plot::plot(&run_dir)

@@ -13,8 +13,14 @@ fn plot_writes_every_figure_and_an_index_that_shows_them() {
     let sim = smithwalk::simulate(&config, Some(2), false).unwrap();
     let dir = tempfile::tempdir().unwrap();
     smithwalk::write_outputs(&sim, &config, dir.path()).unwrap();
-    smithwalk::analysis::compare::compare(dir.path(), &[Model::Single, Model::WangCorrelated], Some(20000), Some(2))
-        .unwrap();
+    smithwalk::analysis::compare::compare(
+        dir.path(),
+        &[Model::Single, Model::WangCorrelated],
+        Some(20000),
+        Some(2),
+        None,
+    )
+    .unwrap();
     let written = smithwalk::exports::plot::plot(dir.path()).unwrap();
     let names: BTreeSet<String> =
         written.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();

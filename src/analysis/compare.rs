@@ -16,6 +16,8 @@ use std::path::Path;
 use anyhow::Result;
 use microsurface::wang::Shadowing;
 
+use crate::analysis::compensation::{AlbedoCache, Compensation, compensated_channels};
+use crate::analysis::external::ExternalModel;
 use crate::analysis::models::{HammonFitPart, hammon_fit_bins, single_scattering_bins};
 use crate::analysis::stats::{self, ChiSquare, WeightedBin};
 use crate::atomic::write_atomically;
@@ -95,6 +97,7 @@ fn predict(
     sim_photons: u64,
     seed: u64,
     threads: Option<usize>,
+    external: Option<&ExternalModel>,
 ) -> Result<Vec<Prediction>> {
     let grid = Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins };
     let cases = crate::setup::cases::expand(config);
@@ -148,6 +151,29 @@ fn predict(
                     let Some(bins) = hammon_fit_bins(case, &grid, part, tol) else { continue };
                     rows(case, slot, Hemisphere::R, channel, &mut |i| Value { energy: bins[i], stderr: 0.0 }, &mut out);
                 }
+            }
+        }
+        Model::KullaConty | Model::Turquin | Model::FdezAguera => {
+            let compensation = match model {
+                Model::KullaConty => Compensation::KullaConty,
+                Model::Turquin => Compensation::Turquin,
+                _ => Compensation::FdezAguera,
+            };
+            let mut cache = AlbedoCache::default();
+            for case in &cases {
+                let rgb = config.is_rgb();
+                let Some(lobes) = compensated_channels(compensation, case, &grid, tol, rgb, &mut cache) else {
+                    continue;
+                };
+                for (channel, bins) in lobes {
+                    rows(case, 0, Hemisphere::R, channel, &mut |i| Value { energy: bins[i], stderr: 0.0 }, &mut out);
+                }
+            }
+        }
+        Model::External => {
+            for lobe in external.map_or(&[][..], |e| &e.lobes[..]) {
+                let value = &mut |i: usize| Value { energy: lobe.energy[i], stderr: lobe.stderr[i] };
+                rows(&cases[lobe.case], lobe.order, lobe.hemisphere, &lobe.channel, value, &mut out);
             }
         }
         Model::HeitzNee | Model::WangCorrelated | Model::WangUncorrelated | Model::ExactPositionFree => {
@@ -260,10 +286,18 @@ fn compare_lobe(
     (test, rel_l1, rel_l2, Value { energy: albedo, stderr: albedo_var.sqrt() })
 }
 
-/// Runs the comparison of `run_dir` with `models` and writes `models.csv` and `compare.csv`
-/// into it; returns the human-readable report.
-pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Option<usize>) -> Result<String> {
+/// Runs the comparison of `run_dir` with `models` and the user's model in `external`, if any,
+/// and writes `models.csv` and `compare.csv` into it; returns the human-readable report.
+pub fn compare(
+    run_dir: &Path,
+    models: &[Model],
+    paths: Option<u64>,
+    threads: Option<usize>,
+    external: Option<&Path>,
+) -> Result<String> {
     let mut config = read_config(run_dir)?;
+    let external = external.map(|path| crate::analysis::external::read(path, &config)).transpose()?;
+    let models = &[models, if external.is_some() { &[Model::External][..] } else { &[] }].concat();
     let measured_photons = config.paths;
     let measured = read_lobes(&run_dir.join("lobes.csv"))?;
     let summary = read_summary(&run_dir.join("summary.csv"))?;
@@ -284,7 +318,7 @@ pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Op
     let mut comparisons = Vec::new();
     for (k, &model) in models.iter().enumerate() {
         let seed = config.seed.wrapping_add(0x9e37_79b9_7f4a_7c15_u64.wrapping_mul(k as u64 + 1));
-        let predictions = predict(model, &config, measured_photons, seed, threads)?;
+        let predictions = predict(model, &config, measured_photons, seed, threads, external.as_ref())?;
         let mut lobes: Vec<(LobeKey, Vec<&Prediction>)> = Vec::new();
         for p in &predictions {
             let mut row = p.fields.clone();
@@ -303,7 +337,11 @@ pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Op
         }
         for (key, bins) in lobes {
             let albedo_measured = summary.get(&key).copied().unwrap_or_default();
-            let model_photons = if matches!(model, Model::Single | Model::HammonFit) { 0 } else { config.paths };
+            let model_photons = match &external {
+                Some(e) if model == Model::External => e.photons(),
+                _ if model.is_exact() => 0,
+                _ => config.paths,
+            };
             let (test, rel_l1, rel_l2, albedo_model) = compare_lobe(&measured, &bins, measured_photons, model_photons);
             comparisons.push(LobeComparison {
                 fields: bins[0].fields.clone(),
