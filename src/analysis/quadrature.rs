@@ -57,7 +57,7 @@ const MAX_PANELS: usize = 20_000;
 
 /// `∫_a^b f` by adaptive bisection until each panel's error estimate is below its share of
 /// `abs_tol`, or below the rounding floor `1e-15 |panel|` (a halved tolerance cannot go below
-/// what doubles resolve), or a depth of 50 halvings, or [`MAX_PANELS`] panels in all. The
+/// what doubles resolve), or a depth of 50 halvings, or `MAX_PANELS` panels in all. The
 /// interval starts as four panels, so that a narrow feature is not missed by a single panel's 15
 /// nodes. Returns the integral and the summed error estimate.
 pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, abs_tol: f64) -> (f64, f64) {
@@ -241,7 +241,7 @@ fn graded(x: (f64, f64), y: (f64, f64), peak: Option<Peak>) -> Vec<((f64, f64), 
 }
 
 /// `∫_{x0}^{x1} ∫_{y0}^{y1} f(x, y) dy dx` by globally adaptive cubature: the rectangle (graded
-/// towards `peak`, see [`graded`]) is covered by cells of the product 7-point Kronrod rule, and
+/// towards `peak`, see `graded`) is covered by cells of the product 7-point Kronrod rule, and
 /// the cell with the largest error estimate is halved across its worse direction until the
 /// summed estimate is at most `max(abs_tol, 1e-14 |value|)` or `max_evaluations` are spent
 /// (then [`Integral::capped`]).
