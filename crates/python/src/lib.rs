@@ -197,7 +197,10 @@ impl NativeRun {
 
     /// The text of `run.json`.
     fn run_json<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
-        let bytes = smithwalk::io::output::run_json(&self.sim, &self.config).map_err(runtime_error)?;
+        use smithwalk::io::output::{lobes_csv, run_json, summary_csv};
+        let tables = (lobes_csv(&self.sim), summary_csv(&self.sim));
+        let (lobes, summary) = (tables.0.map_err(runtime_error)?, tables.1.map_err(runtime_error)?);
+        let bytes = run_json(&self.sim, &self.config, [&lobes, &summary]).map_err(runtime_error)?;
         Ok(PyBytes::new(py, &bytes))
     }
 

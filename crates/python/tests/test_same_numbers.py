@@ -12,7 +12,9 @@ import smithwalk
 from conftest import MONO, RGB
 
 # run.json fields that measure the run rather than describe it.
-TIMING = ("wall_seconds", "paths_per_second", "threads")
+# What differs between two runs of the same config: timing, and the run's identity (a fresh
+# run_id per run, and run.json's digest of itself, which covers it).
+PER_RUN = ("wall_seconds", "paths_per_second", "threads", "run_id", "self_sha256")
 
 
 def run_both(cli, write_config, tmp_path, text, seed):
@@ -29,7 +31,7 @@ def test_save_writes_the_command_lines_files_byte_for_byte(cli, write_config, tm
     for name in ("lobes.csv", "summary.csv"):
         assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
     py, ref = (json.loads((tmp_path / d / "run.json").read_text()) for d in ("py", "cli"))
-    for field in TIMING:
+    for field in PER_RUN:
         py.pop(field), ref.pop(field)
     assert py == ref
     assert sorted(p.name for p in (tmp_path / "py").iterdir()) == ["lobes.csv", "run.json", "summary.csv"]
