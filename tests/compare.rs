@@ -3,7 +3,7 @@
 //! family level 0.01 over the lobes), and the Wang correlated model is rejected for order 2 at
 //! alpha 1, normal incidence, where docs/theory.md §6.6 puts a 27 % excess.
 
-use std::process::Command;
+mod common;
 
 const CONFIG: &str = r#"
 paths = 1_000_000
@@ -29,15 +29,7 @@ paths = 500_000
 #[test]
 fn a_run_with_a_compare_section_measures_the_models() {
     let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("c.toml");
-    std::fs::write(&config, CONFIG).unwrap();
-    let out = dir.path().join("out");
-    let result = Command::new(env!("CARGO_BIN_EXE_smithwalk"))
-        .args(["run", config.to_str().unwrap(), "--out", out.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
-    let stdout = String::from_utf8_lossy(&result.stdout);
+    let (out, stdout) = common::run_config(dir.path(), "out", CONFIG);
     assert!(stdout.contains("single (exact oracle): 12 lobes") && stdout.contains("wang-correlated"), "{stdout}");
     assert!(out.join("models.csv").is_file());
     let mut reader = csv::Reader::from_path(out.join("compare.csv")).unwrap();

@@ -16,6 +16,8 @@
 //!   lobes (the quadrature with a tolerance of 0.05 of each bin's standard error and a bound on
 //!   evaluations; before issue 16.5 these did not finish in 100 s).
 
+mod common;
+
 use sha2::{Digest, Sha256};
 use std::collections::HashSet;
 use std::path::Path;
@@ -43,12 +45,7 @@ fn smithwalk(args: &[&str]) -> Output {
 
 /// Runs `config` into `dir/name` and returns the run directory.
 fn run(dir: &Path, name: &str, config: &str) -> String {
-    let path = dir.join(format!("{name}.toml"));
-    std::fs::write(&path, config).unwrap();
-    let out = dir.join(name).to_str().unwrap().to_string();
-    let result = smithwalk(&["run", path.to_str().unwrap(), "--out", &out]);
-    assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
-    out
+    common::run_config(dir, name, config).0.to_str().unwrap().to_string()
 }
 
 /// The rows of a CSV file as maps from column name to value.

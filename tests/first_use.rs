@@ -2,22 +2,17 @@
 //! columns of `lobes.csv` (`theta_o_deg`, `phi_o_deg`, `solid_angle`). The geometry is checked
 //! against closed forms computed here from the bin limits, not against the writer's own code.
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::Path;
-use std::process::Command;
 
-/// Runs `smithwalk run` on `toml` into a fresh directory; returns its stdout and the directory.
+/// Runs `smithwalk run` on `toml` into `out` of a fresh directory; returns its stdout and the
+/// directory.
 fn run(toml: &str) -> (String, tempfile::TempDir) {
     let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("config.toml");
-    std::fs::write(&config, toml).unwrap();
-    let out = dir.path().join("out");
-    let output = Command::new(env!("CARGO_BIN_EXE_smithwalk"))
-        .args(["run", config.to_str().unwrap(), "--out", out.to_str().unwrap()])
-        .output()
-        .expect("binary runs");
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
-    (String::from_utf8(output.stdout).unwrap(), dir)
+    let (_, stdout) = common::run_config(dir.path(), "out", toml);
+    (stdout, dir)
 }
 
 /// The table rows of the printed energy balance, split on runs of two or more spaces.

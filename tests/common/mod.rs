@@ -15,6 +15,20 @@ pub fn smithwalk_quiet(args: &[&str]) -> std::process::Command {
     c
 }
 
+/// Writes `toml` to `dir/<name>.toml` and runs `smithwalk run` on it into `dir/<name>`,
+/// asserting that it succeeds; returns the run directory and what the run printed.
+pub fn run_config(dir: &std::path::Path, name: &str, toml: &str) -> (std::path::PathBuf, String) {
+    let config = dir.join(format!("{name}.toml"));
+    std::fs::write(&config, toml).unwrap();
+    let out = dir.join(name);
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_smithwalk"))
+        .args(["run", config.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .output()
+        .expect("the smithwalk binary runs");
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    (out, String::from_utf8(output.stdout).unwrap())
+}
+
 /// The bytes of a run directory's `lobes.csv` and `summary.csv`.
 pub fn tables(dir: &std::path::Path) -> (Vec<u8>, Vec<u8>) {
     (std::fs::read(dir.join("lobes.csv")).unwrap(), std::fs::read(dir.join("summary.csv")).unwrap())
