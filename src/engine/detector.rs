@@ -350,9 +350,51 @@ pub struct Detector<const C: usize> {
     unit_hits: Vec<u32>,
     /// Photons counted in `unit_hits`.
     unsettled: u32,
-    /// Scratch space of [`Detector::add_split_photon`], kept so that no photon allocates: a
-    /// split photon's deposits, each twice (in slot 0 and in its order's slot), keyed.
-    keyed: Vec<(usize, [f64; C])>,
+    /// Scratch space of [`Detector::add_split_photon`], kept so that no photon allocates.
+    split: SplitSums<C>,
+}
+
+/// The sums of one split photon's deposits per bin and per hemisphere of every slot it
+/// reached, in dense arrays indexed like the tallies (`slot * 2 bins + hemisphere * bins +
+/// bin`, and `2 slot + hemisphere`), with the indices touched, in the order first touched.
+/// Dense sums cost one addition per deposit, where sorting the deposits by bin cost a sort
+/// and two integer divisions each; every array is back to zero when a photon is done.
+#[derive(Clone, Debug)]
+struct SplitSums<const C: usize> {
+    bins: Vec<Sum<C>>,
+    bins_touched: Vec<usize>,
+    hemispheres: Vec<Sum<C>>,
+    hemispheres_touched: Vec<usize>,
+}
+
+impl<const C: usize> Default for SplitSums<C> {
+    fn default() -> Self {
+        Self { bins: Vec::new(), bins_touched: Vec::new(), hemispheres: Vec::new(), hemispheres_touched: Vec::new() }
+    }
+}
+
+/// A photon's running sum into one tally, and whether any deposit (even of weight 0) reached it.
+#[derive(Clone, Copy, Debug)]
+struct Sum<const C: usize> {
+    weight: [f64; C],
+    reached: bool,
+}
+
+impl<const C: usize> Default for Sum<C> {
+    fn default() -> Self {
+        Self { weight: [0.0; C], reached: false }
+    }
+}
+
+/// Adds `w` to `sums[key]`, noting `key` in `touched` the first time.
+#[inline]
+fn add_to_sum<const C: usize>(sums: &mut [Sum<C>], touched: &mut Vec<usize>, key: usize, w: &[f64; C]) {
+    let sum = &mut sums[key];
+    if !sum.reached {
+        sum.reached = true;
+        touched.push(key);
+    }
+    accumulate(&mut sum.weight, w);
 }
 
 /// Adds photons of weight 1 counted per bin, `hits[slot * bins + i]`, to the bins' tallies.
@@ -399,7 +441,7 @@ impl<const C: usize> Detector<C> {
             last_whole: ([0.0; C], Contribution::of(&[0.0; C])),
             unit_hits: Vec::new(),
             unsettled: 0,
-            keyed: Vec::new(),
+            split: SplitSums::default(),
         }
     }
 
@@ -517,42 +559,30 @@ impl<const C: usize> Detector<C> {
     }
 
     /// A photon that was split deposits several times: sum its deposits per (slot, bin) and
-    /// per (slot, hemisphere) before squaring, so variances stay per photon (§4.6).
+    /// per (slot, hemisphere) before squaring, so variances stay per photon (§4.6). Deposits
+    /// are summed in the order they escaped.
     fn add_split_photon(&mut self) {
         let bins = self.grid.bins();
-        // Keyed by `(slot, hemisphere, bin)` as one number, `(2 slot + hemisphere) bins + bin`,
-        // so that a key divided by `bins` is the (slot, hemisphere) of the albedo tallies.
-        self.keyed.clear();
-        for d in &self.pending {
-            let i = d.hemisphere as usize * bins + d.bin;
-            self.keyed.push((i, d.weight));
-            self.keyed.push((2 * d.slot * bins + i, d.weight));
+        let slots = self.tallies.orders.len();
+        let split = &mut self.split;
+        if split.bins.len() < slots * 2 * bins {
+            split.bins.resize(slots * 2 * bins, Sum::default());
+            split.hemispheres.resize(slots * 2, Sum::default());
         }
-        // Stable: deposits that share a key are summed in the order they escaped.
-        self.keyed.sort_by_key(|&(key, _)| key);
-        let mut bin_sum = [0.0; C];
-        let mut hemi_sum = [0.0; C];
-        for (n, &(key, w)) in self.keyed.iter().enumerate() {
-            accumulate(&mut bin_sum, &w);
-            accumulate(&mut hemi_sum, &w);
-            let (slot, i) = (key / (2 * bins), key % (2 * bins));
-            let next = self.keyed.get(n + 1).map(|&(k, _)| k);
-            let order = &mut self.tallies.orders[slot];
-            let mut bin_contribution = None;
-            if next != Some(key) {
-                let c = Contribution::of(&bin_sum);
-                order.bins[i].add_contribution(&c);
-                bin_contribution = Some((bin_sum, c));
-                bin_sum = [0.0; C];
+        for d in &self.pending {
+            let h = d.hemisphere as usize;
+            for slot in [0, d.slot] {
+                add_to_sum(&mut split.bins, &mut split.bins_touched, (2 * slot + h) * bins + d.bin, &d.weight);
+                add_to_sum(&mut split.hemispheres, &mut split.hemispheres_touched, 2 * slot + h, &d.weight);
             }
-            if next.map(|k| k / bins) != Some(key / bins) {
-                // A hemisphere reached through this bin alone has the same sum: converted once.
-                match bin_contribution {
-                    Some((sum, c)) if sum == hemi_sum => order.albedo[i / bins].add_contribution(&c),
-                    _ => order.albedo[i / bins].add(&hemi_sum),
-                }
-                hemi_sum = [0.0; C];
-            }
+        }
+        for key in split.bins_touched.drain(..) {
+            let sum = std::mem::take(&mut split.bins[key]);
+            self.tallies.orders[key / (2 * bins)].bins[key % (2 * bins)].add(&sum.weight);
+        }
+        for key in split.hemispheres_touched.drain(..) {
+            let sum = std::mem::take(&mut split.hemispheres[key]);
+            self.tallies.orders[key / 2].albedo[key % 2].add(&sum.weight);
         }
     }
 

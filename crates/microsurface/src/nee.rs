@@ -67,6 +67,23 @@ pub struct NextEvent<'a, N, F, O, R> {
 }
 
 impl<N: Ndf, F, O, R> NextEvent<'_, N, F, O, R> {
+    /// Deposits every branch of the facet interaction with normal `m` of a ray travelling
+    /// along `d` into a hit at depth `tau` on `side`.
+    fn scatter<const C: usize>(&mut self, order: u32, tau: f64, side: Side, d: DVec3, m: DVec3, beta: &[f64; C])
+    where
+        F: Facet<C>,
+        R: Rng,
+        O: Observer<C>,
+    {
+        match self.facet.interact(-d, m, side, self.rng) {
+            Interaction::One(b) => self.deposit(order, tau, side, &b, beta),
+            Interaction::Two(a, b) => {
+                self.deposit(order, tau, side, &a, beta);
+                self.deposit(order, tau, side, &b, beta);
+            }
+        }
+    }
+
     /// Deposits `beta * branch weight * P(escape)` of one branch leaving a hit at depth `tau` on
     /// `side`; a branch heading deeper into its side cannot escape before another hit.
     fn deposit<const C: usize>(&mut self, order: u32, tau: f64, side: Side, branch: &Branch<C>, beta: &[f64; C])
@@ -98,17 +115,19 @@ where
     }
 
     fn hit(&mut self, order: u32, tau: f64, side: Side, d: DVec3, weight: &[f64; C]) {
-        // The hit normal is drawn in the flipped frame of the ray's side (§4.3), as the walk does.
+        // The hit normal is drawn in the flipped frame of the ray's side (§4.3), as the walk
+        // does; four at a time where there are as many, so that their draws overlap.
         let sign = if side == Side::Outside { 1.0 } else { -1.0 };
-        for _ in 0..self.samples {
-            let m = sign * self.normals.sample(self.ndf, sign * d, self.rng);
-            match self.facet.interact(-d, m, side, self.rng) {
-                Interaction::One(b) => self.deposit(order, tau, side, &b, weight),
-                Interaction::Two(a, b) => {
-                    self.deposit(order, tau, side, &a, weight);
-                    self.deposit(order, tau, side, &b, weight);
-                }
+        let mut left = self.samples;
+        while left >= 4 {
+            for m in self.normals.sample_lanes(self.ndf, [sign * d; 4], self.rng) {
+                self.scatter(order, tau, side, d, sign * m, weight);
             }
+            left -= 4;
+        }
+        for _ in 0..left {
+            let m = sign * self.normals.sample(self.ndf, sign * d, self.rng);
+            self.scatter(order, tau, side, d, m, weight);
         }
     }
 }
