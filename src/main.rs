@@ -444,7 +444,32 @@ fn print_summary(sim: &Simulation, config: &Config, written: &[PathBuf]) -> std:
         writeln!(out, "wrote {}", path.display())?;
     }
     warn_losses(sim);
+    warn_unreliable_errors(sim);
     Ok(())
+}
+
+/// One line on the console when some albedo's standard error is itself too uncertain to trust
+/// (its VOV, `albedo_vov` in summary.csv, above [`output::VOV_THRESHOLD`]), naming the worst.
+fn warn_unreliable_errors(sim: &Simulation) {
+    let flagged = output::unreliable_albedos(sim);
+    if flagged.is_empty() {
+        return;
+    }
+    let worst: Vec<String> = flagged
+        .iter()
+        .take(5)
+        .map(|&(case, slot, h, c, vov)| {
+            let channel = if sim.rgb { format!(" {}", output::CHANNEL_NAMES[c]) } else { String::new() };
+            format!("case {case} order {slot} {h:?}{channel} (VOV {vov:.2})")
+        })
+        .collect();
+    eprintln!(
+        "note: {} albedo standard errors are unreliable (variance of the variance above {}: rare large \
+         weights dominate; run more photons): {}; all in summary.csv, column albedo_vov",
+        flagged.len(),
+        output::VOV_THRESHOLD,
+        worst.join(", ")
+    );
 }
 
 /// One line on the console when any case lost energy (trapped, NaN or runaway walks): the

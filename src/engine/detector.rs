@@ -141,6 +141,99 @@ impl<const C: usize> Tally<C> {
     }
 }
 
+/// A tally that also keeps the per-photon third and fourth powers, for the variance of its
+/// variance (VOV, docs/theory.md §9.5). Kept for albedos and the energy balance, where a user
+/// reads one number and needs to know whether its standard error can be trusted; the bins,
+/// many thousands per lobe, keep plain [`Tally`]s.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Moments<const C: usize> {
+    pub tally: Tally<C>,
+    #[serde(with = "per_channel")]
+    pub sum_cube: [Fixed; C],
+    #[serde(with = "per_channel")]
+    pub sum_fourth: [Fixed; C],
+}
+
+/// One photon's contribution to a [`Moments`] tally in fixed point: its [`Contribution`] and
+/// the third and fourth powers of its weight.
+#[derive(Clone, Copy, Debug)]
+struct MomentContribution<const C: usize> {
+    low: Contribution<C>,
+    cube: [i128; C],
+    fourth: [i128; C],
+}
+
+impl<const C: usize> MomentContribution<C> {
+    #[inline]
+    fn of(w: &[f64; C]) -> Self {
+        Self {
+            low: Contribution::of(w),
+            cube: w.map(|x| to_fixed(x * x * x)),
+            fourth: w.map(|x| to_fixed(x * x * x * x)),
+        }
+    }
+
+    /// A photon of weight exactly 1 in every channel: every power is 1.
+    const UNIT: Self = {
+        const ONE: i128 = 1 << 64;
+        Self { low: Contribution { sum: [ONE; C], sum_sq: [ONE; C] }, cube: [ONE; C], fourth: [ONE; C] }
+    };
+}
+
+impl<const C: usize> Default for Moments<C> {
+    fn default() -> Self {
+        Self { tally: Tally::default(), sum_cube: [Fixed::default(); C], sum_fourth: [Fixed::default(); C] }
+    }
+}
+
+impl<const C: usize> Moments<C> {
+    /// Adds one photon's total contribution.
+    #[inline]
+    pub fn add(&mut self, w: &[f64; C]) {
+        self.add_contribution(&MomentContribution::of(w));
+    }
+
+    #[inline]
+    fn add_contribution(&mut self, c: &MomentContribution<C>) {
+        self.tally.add_contribution(&c.low);
+        for i in 0..C {
+            self.sum_cube[i].0 += c.cube[i];
+            self.sum_fourth[i].0 += c.fourth[i];
+        }
+    }
+
+    fn merge(&mut self, other: &Self) {
+        self.tally.merge(&other.tally);
+        for (a, b) in
+            self.sum_cube.iter_mut().zip(&other.sum_cube).chain(self.sum_fourth.iter_mut().zip(&other.sum_fourth))
+        {
+            a.merge(*b);
+        }
+    }
+
+    /// [`Tally::mean_and_stderr`].
+    pub fn mean_and_stderr(&self, photons: u64, c: usize) -> (f64, f64) {
+        self.tally.mean_and_stderr(photons, c)
+    }
+
+    /// The relative variance of the variance of the mean over `photons` photons, channel `c`
+    /// (MCNP's VOV, §9.5): `sum (x - m)^4 / (sum (x - m)^2)^2 - 1/N`, with the central sums
+    /// expanded in the raw ones. 0 where the photons do not vary.
+    pub fn vov(&self, photons: u64, c: usize) -> f64 {
+        let n = photons as f64;
+        let s1 = self.tally.sum[c].to_f64();
+        let (s2, s3, s4) = (self.tally.sum_sq[c].to_f64(), self.sum_cube[c].to_f64(), self.sum_fourth[c].to_f64());
+        let m = s1 / n;
+        let second = s2 - n * m * m;
+        let fourth = s4 - 4.0 * m * s3 + 6.0 * m * m * s2 - 3.0 * n * m.powi(4);
+        // Rounding leaves `second` at about 1e-16 s2 where every photon carries the mean.
+        if second <= 1e-12 * s2 || n < 2.0 {
+            return 0.0;
+        }
+        (fourth / (second * second) - 1.0 / n).max(0.0)
+    }
+}
+
 /// The angular grid: bins uniform in |cos theta| and in phi measured from the incident azimuth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Grid {
@@ -186,13 +279,13 @@ pub struct OrderTallies<const C: usize> {
     /// Per hemisphere and bin: index `hemisphere * bins + bin`.
     pub bins: Vec<Tally<C>>,
     /// Per hemisphere.
-    pub albedo: [Tally<C>; 2],
+    pub albedo: [Moments<C>; 2],
 }
 
 impl<const C: usize> OrderTallies<C> {
     /// Empty tallies for `bins` bins over both hemispheres.
     fn empty(bins: usize) -> Self {
-        Self { bins: vec![Tally::default(); bins], albedo: [Tally::default(); 2] }
+        Self { bins: vec![Tally::default(); bins], albedo: [Moments::default(); 2] }
     }
 
     fn merge(&mut self, other: &Self) {
@@ -221,7 +314,7 @@ pub struct Tallies<const C: usize> {
     /// Slot 0: all orders together; slot k: order k (the last slot is "K+" with a `max_order`).
     pub orders: Vec<OrderTallies<C>>,
     /// Per photon: escaped plus lost weight (absorbed = 1 - this).
-    pub accounted: Tally<C>,
+    pub accounted: Moments<C>,
     /// Per photon: weight lost, per [`Loss`] reason (trapped, invalid, runaway).
     pub lost: [Tally<C>; 3],
     pub photons: u64,
@@ -233,7 +326,7 @@ impl<const C: usize> Tallies<C> {
     fn new(grid: &Grid) -> Self {
         Self {
             orders: vec![OrderTallies::empty(2 * grid.bins())],
-            accounted: Tally::default(),
+            accounted: Moments::default(),
             lost: [Tally::default(); 3],
             photons: 0,
             interactions: 0,
@@ -341,7 +434,7 @@ pub struct Detector<const C: usize> {
     any_loss: bool,
     /// The last whole photon's weight and its conversion: successive photons often carry the
     /// same weight (always 1 on white surfaces), and the conversion is then not repeated.
-    last_whole: ([f64; C], Contribution<C>),
+    last_whole: ([f64; C], MomentContribution<C>),
     /// Bin counts of whole photons of weight exactly 1 from [`Observer::escape_photon`], per
     /// slot (`slot * 2 bins + hemisphere * bins + bin`), not yet in the bins' tallies (see
     /// [`Detector::settle`]). On white surfaces nearly every photon is one of these, and
@@ -438,7 +531,7 @@ impl<const C: usize> Detector<C> {
             pending: Vec::new(),
             pending_loss: [[0.0; C]; 3],
             any_loss: false,
-            last_whole: ([0.0; C], Contribution::of(&[0.0; C])),
+            last_whole: ([0.0; C], MomentContribution::of(&[0.0; C])),
             unit_hits: Vec::new(),
             unsettled: 0,
             split: SplitSums::default(),
@@ -477,7 +570,7 @@ impl<const C: usize> Detector<C> {
         }
         self.tallies.accounted.add(&total);
         if let [d] = self.pending[..] {
-            self.add_to_orders(&d, &Contribution::of(&d.weight));
+            self.add_to_orders(&d, &MomentContribution::of(&d.weight));
         } else if !self.pending.is_empty() {
             self.add_split_photon();
         }
@@ -506,7 +599,7 @@ impl<const C: usize> Detector<C> {
     #[inline]
     fn add_whole_photon(&mut self, d: &Deposit<C>) {
         if d.weight != self.last_whole.0 {
-            self.last_whole = (d.weight, Contribution::of(&d.weight));
+            self.last_whole = (d.weight, MomentContribution::of(&d.weight));
         }
         let c = self.last_whole.1;
         self.tallies.accounted.add_contribution(&c);
@@ -517,8 +610,7 @@ impl<const C: usize> Detector<C> {
     /// its bins by count (see `unit_hits`).
     #[inline]
     fn add_unit_photon(&mut self, d: &Deposit<C>) {
-        const UNIT: i128 = 1 << 64;
-        let c = Contribution { sum: [UNIT; C], sum_sq: [UNIT; C] };
+        let c = MomentContribution::UNIT;
         self.tallies.accounted.add_contribution(&c);
         let bins = 2 * self.grid.bins();
         if self.unit_hits.len() < (d.slot + 1) * bins {
@@ -549,11 +641,11 @@ impl<const C: usize> Detector<C> {
 
     /// Adds a photon's only deposit to its bin and albedo in slot 0 (all orders) and in its own slot.
     #[inline]
-    fn add_to_orders(&mut self, d: &Deposit<C>, c: &Contribution<C>) {
+    fn add_to_orders(&mut self, d: &Deposit<C>, c: &MomentContribution<C>) {
         let i = d.hemisphere as usize * self.grid.bins() + d.bin;
         for slot in [0, d.slot] {
             let o = &mut self.tallies.orders[slot];
-            o.bins[i].add_contribution(c);
+            o.bins[i].add_contribution(&c.low);
             o.albedo[d.hemisphere as usize].add_contribution(c);
         }
     }
@@ -632,6 +724,50 @@ mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_pcg::Pcg64Mcg;
+
+    /// The VOV from two-pass central moments of the sample itself.
+    fn vov_two_pass(x: &[f64]) -> f64 {
+        let n = x.len() as f64;
+        let m = x.iter().sum::<f64>() / n;
+        let (c2, c4) = x.iter().fold((0.0, 0.0), |(a, b), &v| (a + (v - m).powi(2), b + (v - m).powi(4)));
+        c4 / (c2 * c2) - 1.0 / n
+    }
+
+    #[test]
+    fn vov_matches_central_moments_and_the_bernoulli_closed_form() {
+        // Weights spread over four decades, as splitting and roulette make them, and a few
+        // large ones: the raw-sum expansion against the two-pass central moments.
+        let mut rng = Pcg64Mcg::seed_from_u64(11);
+        let x: Vec<f64> = (0..20_000)
+            .map(|i| if i % 997 == 0 { 3.0 } else { 10f64.powf(-4.0 * microsurface::random::open01(&mut rng)) })
+            .collect();
+        let mut t = Moments::<1>::default();
+        for &v in &x {
+            t.add(&[v]);
+        }
+        let (got, want) = (t.vov(x.len() as u64, 0), vov_two_pass(&x));
+        assert!((got - want).abs() < 1e-9 * want, "VOV {got} against two-pass {want}");
+        // Weights 0 or 1 with mean p: (1 - 2p)^2 / (N p (1 - p)) (docs/theory.md §9.5), and
+        // photons of weight 1 counted as units give the same.
+        let (n, ones) = (1000u64, 37u64);
+        let mut units = Moments::<1>::default();
+        for i in 0..n {
+            if i < ones {
+                units.add_contribution(&MomentContribution::UNIT);
+            } else {
+                units.add(&[0.0]);
+            }
+        }
+        let p = ones as f64 / n as f64;
+        let closed = (1.0 - 2.0 * p).powi(2) / (n as f64 * p * (1.0 - p));
+        assert!((units.vov(n, 0) - closed).abs() < 1e-12, "{} against {closed}", units.vov(n, 0));
+        // Every photon the same: no variance, VOV 0 (not 0/0).
+        let mut same = Moments::<1>::default();
+        for _ in 0..100 {
+            same.add(&[0.25]);
+        }
+        assert_eq!(same.vov(100, 0), 0.0);
+    }
 
     /// The trigonometric reference: `floor(phi n / 2 pi)` of `phi = atan2` in `[0, 2 pi)`.
     fn reference_phi_bin(n: usize, x: f64, y: f64) -> (usize, f64) {

@@ -37,7 +37,7 @@ impl Kind {
 }
 
 /// The payload format this build writes and reads (format 1 had no header or digest).
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 
 /// The payload in a sealed envelope of `kind`.
 pub fn seal(kind: Kind, payload: &[u8]) -> Vec<u8> {

@@ -8,12 +8,12 @@ use serde::Serialize;
 
 use crate::atomic::write_atomically;
 use crate::engine::Simulation;
-use crate::engine::detector::{Detector, Hemisphere, Tally};
+use crate::engine::detector::{Detector, Hemisphere, Moments, Tally};
 use crate::engine::run::CaseResult;
 use crate::setup::cases::Case;
 use crate::setup::config::{Config, IncidentSide, NormalsKind, SmithKind};
 
-const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
+pub const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
 
 /// The serde name of a config enum value (`"ggx"`, `"hammon-rejection"`, ...).
 pub(crate) fn name<T: Serialize>(value: &T) -> String {
@@ -82,19 +82,21 @@ impl EnergyBalance {
     fn of<const C: usize>(d: &Detector<C>) -> Self {
         let n = d.tallies.photons;
         let mean = |t: &Tally<C>, c| t.mean_and_stderr(n, c).0;
+        let moment_mean = |t: &Moments<C>, c| t.mean_and_stderr(n, c).0;
         let all = &d.tallies.orders[0];
         let last = d.highest_slot();
         Self {
-            reflected: per_channel::<C>(|c| mean(&all.albedo[0], c)),
-            transmitted: per_channel::<C>(|c| mean(&all.albedo[1], c)),
-            absorbed: per_channel::<C>(|c| 1.0 - mean(&d.tallies.accounted, c)),
+            reflected: per_channel::<C>(|c| moment_mean(&all.albedo[0], c)),
+            transmitted: per_channel::<C>(|c| moment_mean(&all.albedo[1], c)),
+            absorbed: per_channel::<C>(|c| 1.0 - moment_mean(&d.tallies.accounted, c)),
             absorbed_stderr: per_channel::<C>(|c| d.tallies.accounted.mean_and_stderr(n, c).1),
             lost_trapped: per_channel::<C>(|c| mean(&d.tallies.lost[0], c)),
             lost_invalid: per_channel::<C>(|c| mean(&d.tallies.lost[1], c)),
             lost_runaway: per_channel::<C>(|c| mean(&d.tallies.lost[2], c)),
             folded: per_channel::<C>(|c| {
                 if d.is_folded(last) {
-                    mean(&d.tallies.orders[last].albedo[0], c) + mean(&d.tallies.orders[last].albedo[1], c)
+                    moment_mean(&d.tallies.orders[last].albedo[0], c)
+                        + moment_mean(&d.tallies.orders[last].albedo[1], c)
                 } else {
                     0.0
                 }
@@ -114,6 +116,37 @@ impl EnergyBalance {
     pub fn lost(&self) -> f64 {
         self.lost_trapped.iter().chain(&self.lost_invalid).chain(&self.lost_runaway).sum()
     }
+}
+
+/// The variance of the variance above which a standard error is not to be trusted (MCNP's
+/// criterion for tallies, docs/theory.md §9.5): the variance is then uncertain by a third or
+/// more, the standard error by a sixth.
+pub const VOV_THRESHOLD: f64 = 0.1;
+
+/// The albedos of `summary.csv` whose VOV is above [`VOV_THRESHOLD`], as `(case, order slot,
+/// hemisphere, channel, VOV)`, largest VOV first.
+pub fn unreliable_albedos(sim: &Simulation) -> Vec<(usize, usize, Hemisphere, usize, f64)> {
+    fn of<const C: usize>(case: &Case, d: &Detector<C>, out: &mut Vec<(usize, usize, Hemisphere, usize, f64)>) {
+        for (slot, order) in d.tallies.orders.iter().enumerate() {
+            for &h in hemispheres(case) {
+                for c in 0..C {
+                    let vov = order.albedo[h as usize].vov(d.tallies.photons, c);
+                    if vov > VOV_THRESHOLD {
+                        out.push((case.index, slot, h, c, vov));
+                    }
+                }
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for (case, result) in sim.cases.iter().zip(&sim.results) {
+        match result {
+            CaseResult::Mono(d) => of(case, d, &mut out),
+            CaseResult::Rgb(d) => of(case, d, &mut out),
+        }
+    }
+    out.sort_by(|a, b| b.4.total_cmp(&a.4));
+    out
 }
 
 /// What the columns of [`balance_table`] mean, printed once above it.
@@ -239,7 +272,8 @@ fn lobe_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Dete
 fn summary_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Detector<C>) -> Result<()> {
     let fields = case_fields(case);
     let n = d.tallies.photons;
-    let mut write = |order: usize, what: &str, c: usize, value: f64, se: f64, folded: bool| {
+    // The VOV cell is empty where it is not estimated: the lost weight sums three tallies.
+    let mut write = |order: usize, what: &str, c: usize, value: f64, se: f64, vov: Option<f64>, folded: bool| {
         let mut row = fields.clone();
         row.push(n.to_string());
         row.push(order.to_string());
@@ -247,23 +281,29 @@ fn summary_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &D
         if C > 1 {
             row.push(CHANNEL_NAMES[c].to_string());
         }
-        row.extend([value.to_string(), se.to_string(), folded.to_string()]);
+        row.extend([
+            value.to_string(),
+            se.to_string(),
+            vov.map_or(String::new(), |v| v.to_string()),
+            folded.to_string(),
+        ]);
         w.write_record(&row)
     };
     for (slot, tallies) in d.tallies.orders.iter().enumerate() {
         for &hemisphere in hemispheres(case) {
             for c in 0..C {
-                let (albedo, se) = tallies.albedo[hemisphere as usize].mean_and_stderr(n, c);
-                write(slot, &format!("{hemisphere:?}"), c, albedo, se, d.is_folded(slot))?;
+                let tally = &tallies.albedo[hemisphere as usize];
+                let (albedo, se) = tally.mean_and_stderr(n, c);
+                write(slot, &format!("{hemisphere:?}"), c, albedo, se, Some(tally.vov(n, c)), d.is_folded(slot))?;
             }
         }
     }
     for c in 0..C {
         let (accounted, se) = d.tallies.accounted.mean_and_stderr(n, c);
-        write(0, "absorbed", c, 1.0 - accounted, se, false)?;
+        write(0, "absorbed", c, 1.0 - accounted, se, Some(d.tallies.accounted.vov(n, c)), false)?;
         let lost: f64 = d.tallies.lost.iter().map(|t| t.mean_and_stderr(n, c).0).sum();
         let lost_se = d.tallies.lost.iter().map(|t| t.mean_and_stderr(n, c).1.powi(2)).sum::<f64>().sqrt();
-        write(0, "lost", c, lost, lost_se, false)?;
+        write(0, "lost", c, lost, lost_se, (lost == 0.0).then_some(0.0), false)?;
     }
     Ok(())
 }
@@ -306,7 +346,7 @@ pub fn summary_csv(sim: &Simulation) -> Result<Vec<u8>> {
     let mut header: Vec<&str> = CASE_COLUMNS.to_vec();
     header.extend(["paths", "order", "hemisphere"]);
     header.extend(channel_header(sim.rgb));
-    header.extend(["albedo", "albedo_stderr", "folded"]);
+    header.extend(["albedo", "albedo_stderr", "albedo_vov", "folded"]);
     w.write_record(&header)?;
     for (case, result) in sim.cases.iter().zip(&sim.results) {
         match result {

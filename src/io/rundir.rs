@@ -269,12 +269,13 @@ fn bin_of(grid: Grid, cos_lo: f64, cos_hi: f64, phi_lo_deg: f64) -> Option<(usiz
 
 /// Checks that `summary.csv` has every case's albedos (per slot, hemisphere and channel), its
 /// absorbed and lost energy exactly once, finite, and non-negative except the absorbed energy
-/// (an unbiased estimate of 1 - the escaped energy, which may dip below 0 by noise).
+/// (an unbiased estimate of 1 - the escaped energy, which may dip below 0 by noise), with
+/// finite non-negative standard errors and VOVs.
 fn check_summary(path: &Path, shape: &Shape) -> Result<()> {
     let table = Table::read(path)?;
     let col = |name| table.column(name);
     let (case_c, order_c, hemi_c, paths_c) = (col("case")?, col("order")?, col("hemisphere")?, col("paths")?);
-    let (albedo_c, stderr_c) = (col("albedo")?, col("albedo_stderr")?);
+    let (albedo_c, stderr_c, vov_c) = (col("albedo")?, col("albedo_stderr")?, col("albedo_vov")?);
     let channel_c = table.column("channel").ok();
     let channels = shape.channels;
     // Per case: slots x hemispheres albedo rows, then absorbed and lost, each per channel.
@@ -301,6 +302,10 @@ fn check_summary(path: &Path, shape: &Shape) -> Result<()> {
         };
         number(r, albedo_c, "albedo", what != Some("absorbed"), &at)?;
         number(r, stderr_c, "albedo_stderr", true, &at)?;
+        // The lost weight sums three tallies; its VOV is left empty unless nothing was lost.
+        if !(what == Some("lost") && r.get(vov_c) == Some("")) {
+            number(r, vov_c, "albedo_vov", true, &at)?;
+        }
         mark(&mut seen, offsets[case] + row * channels + c, &at)?;
     }
     complete(&seen, path, |k| format!("row {k} in the run's order"))
