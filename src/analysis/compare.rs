@@ -32,7 +32,7 @@ use crate::analysis::models::{
 use crate::analysis::stats::{self, ChiSquare, WeightedBin};
 use crate::atomic::write_atomically;
 use crate::engine::detector::{Detector, Grid, Hemisphere};
-use crate::engine::run::{CaseResult, Estimator, Shard};
+use crate::engine::run::{CaseResult, ChainModel, Estimator, Shard};
 use crate::engine::{RunOptions, Simulation};
 use crate::io::output::{CASE_COLUMNS, case_fields, hemisphere_sign, hemispheres};
 use crate::io::rundir::{BinValue, LobeId, Lobes, RunDir};
@@ -278,6 +278,57 @@ fn monte_carlo(
     Ok(out)
 }
 
+/// The chain model behind a Monte Carlo model, if it is one.
+fn chain_model(model: Model) -> Option<ChainModel> {
+    match model {
+        Model::WangCorrelated => Some(ChainModel::Wang(Shadowing::Correlated)),
+        Model::WangUncorrelated => Some(ChainModel::Wang(Shadowing::Uncorrelated)),
+        Model::ExactPositionFree => Some(ChainModel::PositionFree),
+        _ => None,
+    }
+}
+
+/// The lobes of the chain models among `models`, walked on one chain of directions (model `c`
+/// in channel `c`, [`Estimator::JointChains`]) when there are two or more of them and the run
+/// is mono; empty otherwise (each is then walked alone). Each model's estimator is the one it
+/// has alone but for the random numbers, and Russian roulette plays on the largest of the
+/// weights, so no model is noisier than alone.
+fn joint_chains(
+    models: &[Model],
+    config: &Config,
+    seed: u64,
+    threads: Option<usize>,
+    progress: bool,
+) -> Result<Vec<(Model, Predictions)>> {
+    let chained: Vec<(Model, ChainModel)> = models.iter().filter_map(|&m| chain_model(m).map(|c| (m, c))).collect();
+    if config.is_rgb() || chained.len() < 2 {
+        return Ok(Vec::new());
+    }
+    let (start, cpu_start) = (Instant::now(), cpu_seconds());
+    let kinds = std::array::from_fn(|c| chained[c.min(chained.len() - 1)].1);
+    let model_config = Config { seed, ..config.clone() };
+    let options =
+        RunOptions { estimator: Estimator::JointChains(kinds), shard: Shard::WHOLE, threads, show_progress: progress };
+    let sim = crate::engine::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))?;
+    let mut out: Vec<(Model, Predictions)> = chained.iter().map(|&(m, _)| (m, Predictions::default())).collect();
+    for_each_lobe(&sim, &mut |case, lobe| {
+        // With two models the third channel repeats the second.
+        if let Some((model, predictions)) = out.get_mut(lobe.channel)
+            && (*model != Model::ExactPositionFree || case.position_free_applies())
+        {
+            predictions.lobes.push(ModelLobe { channel: 0, ..lobe });
+        }
+    });
+    let names: Vec<&str> = out.iter().map(|(m, _)| m.name()).collect();
+    eprintln!(
+        "compare: {} walked on one chain of directions in {:.1} s ({:.1} CPU s)",
+        names.join(", "),
+        start.elapsed().as_secs_f64(),
+        cpu_seconds() - cpu_start
+    );
+    Ok(out)
+}
+
 /// Calls `f` for every lobe (case, order, hemisphere, channel) of a simulation.
 fn for_each_lobe(sim: &Simulation, f: &mut dyn FnMut(&Case, ModelLobe)) {
     fn visit<const C: usize>(case: &Case, d: &Detector<C>, f: &mut dyn FnMut(&Case, ModelLobe)) {
@@ -420,6 +471,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
     let mut notes: Vec<(Model, String)> = Vec::new();
     let mut skipped: Vec<(Model, String)> = Vec::new();
     let empty: Vec<BinValue> = vec![BinValue::default(); run.grid.bins()];
+    let mut joint: Option<Vec<(Model, Predictions)>> = None;
     for (k, &model) in options.models.iter().enumerate() {
         let (start, cpu_start) = (Instant::now(), cpu_seconds());
         if terminal {
@@ -433,7 +485,15 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
                 bar.finish_and_clear();
                 p
             }
-            _ => monte_carlo(model, &config, seed, options.threads, terminal)?,
+            _ => {
+                if chain_model(model).is_some() && joint.is_none() {
+                    joint = Some(joint_chains(&options.models, &config, seed, options.threads, terminal)?);
+                }
+                match joint.as_mut().and_then(|j| j.iter().position(|(m, _)| *m == model).map(|i| j.swap_remove(i).1)) {
+                    Some(p) => p,
+                    None => monte_carlo(model, &config, seed, options.threads, terminal)?,
+                }
+            }
         };
         if let Some(reason) = predictions.skipped {
             skipped.push((model, reason));

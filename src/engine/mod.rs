@@ -148,7 +148,8 @@ pub fn simulate_from(
     let cases = crate::setup::cases::expand(config);
     let settings =
         RunSettings { shard: options.shard, estimator: options.estimator, ..RunSettings::from_config(config) };
-    let rgb = config.is_rgb();
+    // Joint chains carry one model per channel of an RGB detector.
+    let rgb = config.is_rgb() || matches!(options.estimator, Estimator::JointChains(_));
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(n) = options.threads {
         builder = builder.num_threads(n);

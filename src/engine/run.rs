@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc;
 
 use indicatif::ProgressBar;
-use microsurface::chain;
+use microsurface::chain::{self, Escapes, Visibility};
 use microsurface::facet::{Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Lambertian};
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 use microsurface::nee::NextEvent;
@@ -65,6 +65,65 @@ pub enum Estimator {
     /// The exact position-free chain (§7.1). Cases it does not describe
     /// ([`Case::position_free_applies`]) are skipped: their photons deposit nothing.
     PositionFree,
+    /// Up to three chain models on one chain of directions, model `c` in channel `c` of an
+    /// RGB detector (mono cases only; see [`chain::trace`]). Where the position-free chain
+    /// does not apply, its channel follows the first model and means nothing.
+    JointChains([ChainModel; 3]),
+}
+
+/// A height-free chain model (§6.5, §7.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ChainModel {
+    Wang(Shadowing),
+    PositionFree,
+}
+
+/// The visibility of a [`ChainModel`] for one photon.
+#[derive(Clone, Debug)]
+enum ChainVisibility {
+    Wang(Shadowing),
+    PositionFree(DepthProfile),
+}
+
+impl ChainVisibility {
+    fn of(model: ChainModel, case: &Case, fallback: ChainModel) -> Self {
+        match model {
+            ChainModel::Wang(s) => ChainVisibility::Wang(s),
+            ChainModel::PositionFree if case.position_free_applies() => {
+                ChainVisibility::PositionFree(DepthProfile::default())
+            }
+            ChainModel::PositionFree => Self::of(fallback, case, ChainModel::Wang(Shadowing::Correlated)),
+        }
+    }
+}
+
+impl Visibility for ChainVisibility {
+    fn enter(&mut self, rate: f64) {
+        match self {
+            ChainVisibility::Wang(s) => s.enter(rate),
+            ChainVisibility::PositionFree(p) => p.enter(rate),
+        }
+    }
+
+    fn leave(&mut self, rate_in: f64, rate_out: f64, up: bool, refracted: bool) -> f64 {
+        match self {
+            ChainVisibility::Wang(s) => s.leave(rate_in, rate_out, up, refracted),
+            ChainVisibility::PositionFree(p) => p.leave(rate_in, rate_out, up, refracted),
+        }
+    }
+}
+
+/// One visibility per channel of the chain's weight.
+struct PerChannel<const C: usize>([ChainVisibility; C]);
+
+impl<const C: usize> Escapes<C> for PerChannel<C> {
+    fn start(&mut self, rate: f64) {
+        self.0.iter_mut().for_each(|v| v.enter(rate));
+    }
+
+    fn escaping(&mut self, rate_in: f64, rate_out: f64, up: bool, refracted: bool) -> [f64; C] {
+        std::array::from_fn(|c| self.0[c].leave(rate_in, rate_out, up, refracted))
+    }
 }
 
 /// What every case of a run shares.
@@ -281,6 +340,12 @@ where
         let mut stack = Vec::new();
         let mut nee_rng = chunk_rng(w.settings.seed ^ NEE_STREAMS, w.case.index, chunk);
         let mut profile = DepthProfile::default();
+        let mut joint = match w.settings.estimator {
+            Estimator::JointChains(models) => {
+                Some(PerChannel(std::array::from_fn(|c| ChainVisibility::of(models[c], w.case, models[0]))))
+            }
+            _ => None,
+        };
         for _ in 0..photons {
             let interactions = match w.settings.estimator {
                 Estimator::Walk => w.surface.trace(&w.facet, policy, wi, &mut rng, &mut stack, detector),
@@ -290,6 +355,10 @@ where
                 Estimator::PositionFree if !w.case.position_free_applies() => 0,
                 Estimator::PositionFree => {
                     chain::trace(&mut profile, &w.surface.ndf, &w.facet, policy, wi, &mut rng, detector)
+                }
+                Estimator::JointChains(_) => {
+                    let joint = joint.as_mut().expect("built above for joint chains");
+                    chain::trace(joint, &w.surface.ndf, &w.facet, policy, wi, &mut rng, detector)
                 }
                 Estimator::HeitzNee(samples) => {
                     let (ndf, normals, facet, sink) = (&w.surface.ndf, w.surface.normals, &w.facet, &mut *detector);

@@ -30,9 +30,35 @@ pub trait Visibility {
     fn leave(&mut self, rate_in: f64, rate_out: f64, up: bool, refracted: bool) -> f64;
 }
 
+/// What escapes after each vertex, channel by channel of the chain's weight: one
+/// [`Visibility`] for every channel (any `V: Visibility`), or one model per channel, so that
+/// one chain of directions serves several models at once.
+pub trait Escapes<const C: usize> {
+    /// Starts a photon: [`Visibility::enter`] of every channel's model.
+    fn start(&mut self, rate: f64);
+
+    /// The fraction of each channel's weight that escapes: [`Visibility::leave`] per channel.
+    fn escaping(&mut self, rate_in: f64, rate_out: f64, up: bool, refracted: bool) -> [f64; C];
+}
+
+impl<V: Visibility, const C: usize> Escapes<C> for V {
+    fn start(&mut self, rate: f64) {
+        self.enter(rate);
+    }
+
+    fn escaping(&mut self, rate_in: f64, rate_out: f64, up: bool, refracted: bool) -> [f64; C] {
+        [self.leave(rate_in, rate_out, up, refracted); C]
+    }
+}
+
 /// Walks one photon arriving from `wi` (towards the light) through the chain with `visibility`
 /// and deposits the escaping weight of every order into `observer`, like the random walk does.
 /// Returns the number of facet interactions.
+///
+/// The directions do not depend on the visibility, so channels with different models are
+/// unbiased estimators of each model: only the weights differ, and Russian roulette (on the
+/// largest channel) and the choice between two branches divide every channel by the same
+/// probability.
 #[allow(clippy::too_many_arguments)]
 pub fn trace<V, N, F, R, O, const C: usize>(
     visibility: &mut V,
@@ -44,7 +70,7 @@ pub fn trace<V, N, F, R, O, const C: usize>(
     observer: &mut O,
 ) -> u64
 where
-    V: Visibility,
+    V: Escapes<C>,
     N: Ndf,
     F: Facet<C>,
     R: Rng + ?Sized,
@@ -59,7 +85,7 @@ where
     // Depth rate of the arriving direction (true Smith, §2.4); each leaving direction's rate
     // is the next vertex's arriving one.
     let mut rate_in = Smith::Exact.rate(ndf, flip(d, side));
-    visibility.enter(rate_in);
+    visibility.start(rate_in);
     loop {
         let d_own = flip(d, side);
         let m = flip(ndf.sample_visible(-d_own, rng), side);
@@ -84,15 +110,15 @@ where
         d = branch.dir;
         let d_out = flip(d, side);
         let rate_out = Smith::Exact.rate(ndf, d_out);
-        let p = visibility.leave(rate_in, rate_out, d_out.z > 0.0, branch.crosses);
+        let p = visibility.escaping(rate_in, rate_out, d_out.z > 0.0, branch.crosses);
         rate_in = rate_out;
-        if !d.is_finite() || !p.is_finite() || weight.iter().any(|w| !w.is_finite()) {
+        if !d.is_finite() || p.iter().chain(&weight).any(|x| !x.is_finite()) {
             observer.lose(Loss::Invalid, &weight);
             return u64::from(order);
         }
-        if p > 0.0 {
-            observer.escape(order, side, d, &weight.map(|w| w * p));
-            weight = weight.map(|w| w * (1.0 - p));
+        if p.iter().any(|&p| p > 0.0) {
+            observer.escape(order, side, d, &std::array::from_fn(|c| weight[c] * p[c]));
+            weight = std::array::from_fn(|c| weight[c] * (1.0 - p[c]));
         }
         match roulette(&weight, policy.threshold, rng) {
             Some(w) => weight = w,
