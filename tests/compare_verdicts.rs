@@ -99,6 +99,31 @@ fn a_folded_run_gives_no_rejection_that_an_unfolded_one_does_not() {
 }
 
 #[test]
+fn a_model_gives_the_same_numbers_whichever_models_are_compared_with_it() {
+    // The Monte Carlo models' streams come from the run's seed and the model's name; the
+    // chain models walked together depend on which of them share the walk, not on the order.
+    let dir = tempfile::tempdir().unwrap();
+    let out = run(dir.path(), "run", &format!("paths = 20_000\n{CASES}max_order = 3\n"));
+    let model_rows = |models: &str, model: &str| {
+        let result = smithwalk(&["compare", &out, "--models", models]);
+        assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
+        let mut rows: Vec<String> = rows(&format!("{out}/compare.csv"))
+            .into_iter()
+            .filter(|r| r["model"] == model)
+            .map(|r| format!("{} {} {} {} {}", r["case"], r["order"], r["hemisphere"], r["chi2"], r["albedo_model"]))
+            .collect();
+        rows.sort();
+        assert!(!rows.is_empty(), "{model} compared with {models}");
+        rows
+    };
+    assert_eq!(model_rows("heitz-nee", "heitz-nee"), model_rows("single,wang-uncorrelated,heitz-nee", "heitz-nee"));
+    assert_eq!(
+        model_rows("wang-correlated,exact-position-free", "wang-correlated"),
+        model_rows("exact-position-free,wang-correlated", "wang-correlated")
+    );
+}
+
+#[test]
 fn a_wrong_measurement_is_rejected_and_fails_the_gate() {
     let dir = tempfile::tempdir().unwrap();
     let out = run(dir.path(), "run", &format!("paths = 100_000\n{CASES}max_order = 3\n"));

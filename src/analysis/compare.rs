@@ -278,6 +278,13 @@ fn monte_carlo(
     Ok(out)
 }
 
+/// The seed of a Monte Carlo model's streams: the run's seed mixed with the model's name (FNV-1a),
+/// so that a model gives the same numbers whichever other models are compared with it.
+fn model_seed(run_seed: u64, name: &str) -> u64 {
+    let fnv = name.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3));
+    run_seed ^ fnv
+}
+
 /// The chain model behind a Monte Carlo model, if it is one.
 fn chain_model(model: Model) -> Option<ChainModel> {
     match model {
@@ -296,14 +303,18 @@ fn chain_model(model: Model) -> Option<ChainModel> {
 fn joint_chains(
     models: &[Model],
     config: &Config,
-    seed: u64,
     threads: Option<usize>,
     progress: bool,
 ) -> Result<Vec<(Model, Predictions)>> {
-    let chained: Vec<(Model, ChainModel)> = models.iter().filter_map(|&m| chain_model(m).map(|c| (m, c))).collect();
+    // Channels in the models' canonical order, so that the joint walk depends on which models
+    // share it, not on the order they were asked for in.
+    let chained: Vec<(Model, ChainModel)> =
+        Model::ALL.iter().filter(|m| models.contains(m)).filter_map(|&m| chain_model(m).map(|c| (m, c))).collect();
     if config.is_rgb() || chained.len() < 2 {
         return Ok(Vec::new());
     }
+    let names: Vec<&str> = chained.iter().map(|(m, _)| m.name()).collect();
+    let seed = model_seed(config.seed, &names.join(","));
     let (start, cpu_start) = (Instant::now(), cpu_seconds());
     let kinds = std::array::from_fn(|c| chained[c.min(chained.len() - 1)].1);
     let model_config = Config { seed, ..config.clone() };
@@ -319,7 +330,6 @@ fn joint_chains(
             predictions.lobes.push(ModelLobe { channel: 0, ..lobe });
         }
     });
-    let names: Vec<&str> = out.iter().map(|(m, _)| m.name()).collect();
     eprintln!(
         "compare: {} walked on one chain of directions in {:.1} s ({:.1} CPU s)",
         names.join(", "),
@@ -477,7 +487,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
         if terminal {
             eprintln!("compare: {} ({}/{})", model.name(), k + 1, options.models.len());
         }
-        let seed = config.seed.wrapping_add(0x9e37_79b9_7f4a_7c15_u64.wrapping_mul(k as u64 + 1));
+        let seed = model_seed(config.seed, model.name());
         let predictions = match model {
             Model::Single | Model::HammonFit => {
                 let bar = model_progress(model, terminal);
@@ -487,7 +497,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
             }
             _ => {
                 if chain_model(model).is_some() && joint.is_none() {
-                    joint = Some(joint_chains(&options.models, &config, seed, options.threads, terminal)?);
+                    joint = Some(joint_chains(&options.models, &config, options.threads, terminal)?);
                 }
                 match joint.as_mut().and_then(|j| j.iter().position(|(m, _)| *m == model).map(|i| j.swap_remove(i).1)) {
                     Some(p) => p,
