@@ -163,6 +163,11 @@ enum Command {
         /// slows a run down).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
+        /// Instead, the time to a 1% relative standard error on each per-order albedo (orders
+        /// 1, 2, 3 and all, R and T) on 1 thread, and the speed-up over the Heitz et al. 2016
+        /// reference code from its binomial variance and its measured rate (docs/performance.md).
+        #[arg(long)]
+        precision: bool,
     },
 }
 
@@ -204,6 +209,39 @@ fn bench(paths: u64, repeats: usize) -> Result<()> {
             one.ns_per_interaction(),
             one.interactions_per_path
         );
+        if !print_line(&mut out, &row)? {
+            return Ok(());
+        }
+    }
+    Ok(())
+}
+
+/// The time-to-precision table of `smithwalk bench --precision`: per case, paths per
+/// CPU-second on 1 thread, then per albedo (orders 1, 2, 3 and all, R then T) the CPU seconds to
+/// a 1% relative standard error and, in brackets, the reference's time over it (`-`: no light
+/// goes there; `exact`: no variance, as the all-orders reflection of a conductor with F = 1).
+fn bench_precision(paths: u64) -> Result<()> {
+    use smithwalk::engine::bench::{precision_cases, time_to_precision};
+    let mut out = std::io::stdout().lock();
+    let quantities = ["R1", "R2", "R3", "R", "T1", "T2", "T3", "T"];
+    let mut header = format!("{:<28} {:>12}", "case (alpha, theta_i rad)", "paths/cpu-s");
+    for q in quantities {
+        header += &format!(" {q:>16}");
+    }
+    if !print_line(&mut out, &header)? {
+        return Ok(());
+    }
+    for (material, toml, alpha, theta) in precision_cases() {
+        let (rate, albedos) = time_to_precision(material, toml, alpha, theta, paths)?;
+        let mut row = format!("{:<28} {rate:>12.3e}", format!("{material} {alpha} {theta}"));
+        for a in albedos {
+            let cell = match a {
+                None => "-".to_string(),
+                Some(a) if a.seconds == 0.0 => "exact".to_string(),
+                Some(a) => format!("{:.2e}s ({:.1}x)", a.seconds, a.speedup),
+            };
+            row += &format!(" {cell:>16}");
+        }
         if !print_line(&mut out, &row)? {
             return Ok(());
         }
@@ -534,7 +572,8 @@ fn main() -> ExitCode {
             let out = out.unwrap_or_else(|| run_dir.join("brdf.bsdf"));
             smithwalk::exports::rgl::export(&run_dir, &out, resolution).map(|p| println!("wrote {}", p.display()))
         }
-        Command::Bench { paths, repeats } => bench(paths, repeats),
+        Command::Bench { paths, precision: true, .. } => bench_precision(paths),
+        Command::Bench { paths, repeats, .. } => bench(paths, repeats),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 use anyhow::Result;
 use rustix::time::{ClockId, clock_gettime};
 
+use crate::engine::detector::Hemisphere;
 use crate::engine::simulate;
 use crate::setup::config::Config;
 
@@ -97,4 +98,104 @@ pub fn measure_pair(case: usize, paths: u64) -> Result<f64> {
     });
     // Both runs walk `paths`: the pair's rate is twice the slower one's.
     Ok(2.0 * a?.paths_per_second.min(b?.paths_per_second))
+}
+
+/// The cases of the time-to-precision table: GGX conductor (F = 1), dielectric (eta 1.5) and
+/// Lambertian (albedo 1) facets, each at (alpha, theta_i in radians) of the Heitz 2016
+/// comparison (0.5, 1.0) and at alpha 0.25 and 1.0, normal and 1.5 rad incidence.
+pub fn precision_cases() -> Vec<(&'static str, &'static str, f64, f64)> {
+    let materials = [
+        ("conductor", "kind = \"conductor\""),
+        ("dielectric", "kind = \"dielectric\"\neta = 1.5"),
+        ("lambertian", "kind = \"diffuse\"\nalbedo = 1.0"),
+    ];
+    let angles = [(0.5, 1.0), (0.25, 0.0), (0.25, 1.5), (1.0, 0.0), (1.0, 1.5)];
+    materials
+        .iter()
+        .flat_map(|&(name, toml)| angles.iter().map(move |&(alpha, theta)| (name, toml, alpha, theta)))
+        .collect()
+}
+
+/// Paths per CPU-second of the Heitz et al. 2016 reference code (`-O2`, its `float` build)
+/// per material, as measured for the throughput issue on this kind of machine: 2.5-2.7 M for
+/// the conductor; 2.9 M for the dielectric; 2.1-2.9 M over the materials. The top of each
+/// range is used (the Lambertian's is not given apart: 2.9 M), so that the speed-ups below
+/// are not flattered.
+pub fn reference_paths_per_second(material: &str) -> f64 {
+    match material {
+        "conductor" => 2.7e6,
+        _ => 2.9e6,
+    }
+}
+
+/// One per-order albedo of a time-to-precision measurement.
+#[derive(Clone, Copy, Debug)]
+pub struct Precision {
+    /// The albedo.
+    pub albedo: f64,
+    /// CPU seconds for smithwalk to reach a relative standard error of 1% on it.
+    pub seconds: f64,
+    /// The reference's CPU seconds for the same, over smithwalk's.
+    pub speedup: f64,
+}
+
+/// Time to a relative standard error of 1% on the albedos of orders 1, 2, 3 and all, R then T,
+/// of one case on 1 thread: smithwalk's per-photon variance (`stderr^2 N`) over its measured
+/// paths per CPU-second, against the reference's binomial variance `p (1 - p)` (it walks
+/// unit-weight photons with coin escapes) over its rate. `None` where no light goes.
+pub fn time_to_precision(
+    material: &str,
+    toml: &str,
+    alpha: f64,
+    theta: f64,
+    paths: u64,
+) -> Result<(f64, Vec<Option<Precision>>)> {
+    let config = Config::parse(&format!(
+        "paths = {paths}\nseed = 1\n[surface]\nalpha = {alpha}\n[material]\n{toml}\n[incident]\ntheta_rad = {theta}\n[detector]\nmax_order = 4\n"
+    ))?;
+    let cpu = process_cpu_time();
+    let sim = simulate(&config, Some(1), false)?;
+    let rate = paths as f64 / (process_cpu_time() - cpu).as_secs_f64();
+    let reference = reference_paths_per_second(material);
+    let result = &sim.results[0];
+    let mut out = Vec::new();
+    for hemisphere in [Hemisphere::R, Hemisphere::T] {
+        for slot in [1, 2, 3, 0] {
+            let (p, se) = result.albedo(slot, hemisphere);
+            // A quantity without variance (a conductor with F = 1 reflects everything) is
+            // exact at once, for both codes: reported as 0 seconds and a speed-up of 1.
+            out.push((p > 0.0).then(|| {
+                if se == 0.0 {
+                    return Precision { albedo: p, seconds: 0.0, speedup: 1.0 };
+                }
+                // Photons to a relative standard error of 1%: variance per photon / (0.01 p)^2.
+                let photons = |variance: f64| variance / (0.01 * p).powi(2);
+                let seconds = photons(se * se * paths as f64) / rate;
+                let reference_seconds = photons(p * (1.0 - p)) / reference;
+                Precision { albedo: p, seconds, speedup: reference_seconds / seconds }
+            }));
+        }
+    }
+    Ok((rate, out))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unit_weight_walks_gain_exactly_their_throughput_ratio() {
+        // A conductor with F = 1 walks photons of weight 1 with one escape each, like the
+        // reference: the per-order variances are binomial on both sides, so every speed-up is
+        // the ratio of the rates (times (N - 1) / N: smithwalk's variance is the unbiased sample
+        // variance), and the all-orders albedo (1, without variance) is exact.
+        let n = 20_000;
+        let (rate, albedos) = time_to_precision("conductor", "kind = \"conductor\"", 0.5, 1.0, n).unwrap();
+        let ratio = rate / reference_paths_per_second("conductor") * (n - 1) as f64 / n as f64;
+        for a in albedos[..3].iter().map(|a| a.expect("orders 1 to 3 reflect light")) {
+            assert!((a.speedup / ratio - 1.0).abs() < 1e-9, "{} against {ratio}", a.speedup);
+        }
+        assert_eq!(albedos[3].map(|a| a.seconds), Some(0.0));
+        assert!(albedos[4..].iter().all(Option::is_none), "a conductor transmits nothing");
+    }
 }
