@@ -548,8 +548,10 @@ impl RunDir {
         read_bins(&self.path.join("lobes.csv"), self.grid)
     }
 
-    /// The model lobes of `models.csv` per model name (a model without any lobe is absent),
-    /// once the file is checked ([`read_models`]); empty if `compare` has not run.
+    /// The model lobes of `models.csv` per model name (its columns `<name>` with a
+    /// `<name>_stderr`; a model without any lobe is absent), once the file is checked: the rows
+    /// of `lobes.csv` in its order, each model's two cells both empty or both finite numbers
+    /// >= 0. Empty if `compare` has not run.
     pub fn models(&self) -> Result<HashMap<String, Lobes>> {
         let path = self.path.join("models.csv");
         if !path.exists() {
