@@ -17,25 +17,6 @@ use smithwalk::analysis::compare::compare;
 use smithwalk::io::rundir::RunDir;
 use smithwalk::setup::config::Model;
 
-/// No `max_order`: each case has the slots its light reached; the models walk ten times more
-/// photons, so some reach orders the run does not have.
-const MONO: &str = r#"
-paths = 2000
-seed = 5
-[surface]
-alpha = [0.4, 1.0]
-[[material]]
-kind = "conductor"
-[[material]]
-kind = "dielectric"
-eta = 1.5
-[incident]
-theta_deg = [0, 70]
-[detector]
-cos_theta_bins = 8
-phi_bins = 16
-"#;
-
 const RGB: &str = r#"
 paths = 5000
 seed = 6
@@ -114,7 +95,9 @@ fn cells<'a>(table: &'a Table, model: &str) -> impl Iterator<Item = (&'a Vec<Str
 fn a_mono_run_has_the_rows_of_lobes_csv_and_a_cell_per_model_where_it_applies() {
     let dir = tempfile::tempdir().unwrap();
     let models = [Model::Single, Model::HeitzNee, Model::ExactPositionFree, Model::WangUncorrelated];
-    let (lobes, table) = compared(dir.path(), MONO, &models, 20_000);
+    // No `max_order`: each case has the slots its light reached; the models walk ten times more
+    // photons, so some reach orders the run does not have.
+    let (lobes, table) = compared(dir.path(), &format!("paths = 2000\n{}", common::CASES), &models, 20_000);
     let (case, order) = (table.column("case").unwrap(), table.column("order").unwrap());
     let material = lobes.column("material").unwrap();
     let dielectric: HashSet<&str> =
