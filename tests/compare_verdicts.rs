@@ -25,7 +25,6 @@ use std::process::{Command, Output};
 
 use common::CASES;
 
-
 fn smithwalk(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_smithwalk")).args(args).output().unwrap()
 }
