@@ -179,7 +179,7 @@ fn a_models_csv_that_is_not_row_for_row_lobes_csv_is_refused() {
     let mut swapped = lines.clone();
     swapped.swap(1, 2);
     let err = error(swapped.join("\n") + "\n").unwrap();
-    assert!(err.contains("line 2: not the bin of lobes.csv's row 2"), "{err}");
+    assert!(err.contains("line 2: not the bin of lobes.csv's line 2"), "{err}");
     // A row missing.
     let err = error(lines[..lines.len() - 1].join("\n") + "\n").unwrap();
     assert!(err.contains("rows, but the run in run.json has"), "{err}");

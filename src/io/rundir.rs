@@ -337,7 +337,7 @@ fn read_models(path: &Path, shape: &Shape) -> Result<HashMap<String, Lobes>> {
         let key = keys.key(r, shape, &offsets, &at)?;
         if key.row != line {
             bail!(
-                "{}: not the bin of lobes.csv's row {} (models.csv has the rows of lobes.csv, in its order)",
+                "{}: not the bin of lobes.csv's line {} (models.csv has the rows of lobes.csv, in its order)",
                 at(),
                 line + 2
             );
