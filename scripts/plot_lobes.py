@@ -8,7 +8,9 @@ energy over its solid angle, 1/sr) in the plane of incidence against the signed 
 (positive on the mirror side, phi = 180 deg; negative on the light's side, phi = 0). The
 random walk is drawn as black points with one-standard-error bars; when models.csv sits next
 to lobes.csv (after `smithwalk compare`), every model as a line in its fixed colour and dash,
-the same as in `smithwalk plot` (docs/figures.md).
+the same as in `smithwalk plot` (docs/figures.md). models.csv has the rows of lobes.csv in the
+same order, and per model a column `<model>` (its energy) with a column `<model>_stderr`; a
+model's cells are empty where it gives no lobe (docs/compare.md).
 
     python3 scripts/plot_lobes.py out/quickstart/lobes.csv --out lobes.png [--orders 1 2 3 0]
 
@@ -27,6 +29,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
+# A bin's edges: what plane_of_incidence needs besides the energy.
+BIN_EDGES = ["cos_lo", "cos_hi", "phi_lo_deg", "phi_hi_deg"]
 SURFACE = ["ndf", "alpha_x", "alpha_y", "height", "smith", "normals", "material", "phi_i_deg", "side"]
 # The fixed style of every model, as in src/exports/plot/style.rs: (colour, dash).
 MODEL_STYLE = {
@@ -72,11 +76,16 @@ def main():
 
     df = pd.read_csv(args.lobes)
     models_path = args.models or os.path.join(os.path.dirname(os.path.abspath(args.lobes)), "models.csv")
-    models = pd.read_csv(models_path) if os.path.exists(models_path) else None
+    model_names = []
+    if os.path.exists(models_path):
+        models = pd.read_csv(models_path)
+        if len(models) != len(df):
+            sys.exit(f"{models_path} has {len(models)} rows, {args.lobes} {len(df)}: not the models of this run")
+        # Row for row beside lobes.csv: each model's energy becomes a column of df.
+        model_names = [name for name in models.columns if f"{name}_stderr" in models.columns]
+        df = pd.concat([df, models[model_names].add_prefix("model:")], axis=1)
     if "channel" in df.columns:
         df = df[df.channel == args.channel]
-        if models is not None and "channel" in models.columns:
-            models = models[models.channel == args.channel]
     summary_path = os.path.join(os.path.dirname(os.path.abspath(args.lobes)), "summary.csv")
     folded = None
     if os.path.exists(summary_path):
@@ -101,15 +110,16 @@ def main():
             case = surface[surface.theta_i_deg == theta]
             for r, order in enumerate(orders):
                 ax = axes[r][t]
-                lobe = plane_of_incidence(case[case.order == order])
-                if models is not None:
-                    these = models[(models.case == case.case.iloc[0]) & (models.order == order)]
-                    these = these[these.hemisphere == hemisphere]
-                    for name, model in these.groupby("model", sort=True):
-                        colour, dash = MODEL_STYLE.get(name, ("#777777", "-"))
-                        m = plane_of_incidence(model)
-                        ax.plot(m.theta_o, m.lobe, color=colour, linestyle=dash, lw=1.3, label=name)
-                        drawn.add(name)
+                these = case[case.order == order]
+                lobe = plane_of_incidence(these)
+                for name in sorted(model_names):
+                    given = these[these[f"model:{name}"].notna()]
+                    if given.empty:
+                        continue
+                    colour, dash = MODEL_STYLE.get(name, ("#777777", "-"))
+                    m = plane_of_incidence(given[BIN_EDGES].assign(energy=given[f"model:{name}"]))
+                    ax.plot(m.theta_o, m.lobe, color=colour, linestyle=dash, lw=1.3, label=name)
+                    drawn.add(name)
                 if not lobe.empty:
                     ax.errorbar(
                         lobe.theta_o, lobe.lobe, yerr=lobe.lobe_se, fmt="o", ms=2, color="black",
@@ -137,7 +147,7 @@ def main():
         out = args.out if len(groups) == 1 else f"{stem}_g{g}_{hemisphere}{ext}"
         fig.savefig(out, dpi=150)
         plt.close(fig)
-        print(f"wrote {out}", file=sys.stderr)
+        print(f"wrote {out}" + (f" with {', '.join(sorted(drawn))}" if drawn else ""), file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -23,21 +23,7 @@ use std::collections::HashSet;
 use std::path::Path;
 use std::process::{Command, Output};
 
-const CASES: &str = r#"
-seed = 11
-[surface]
-alpha = [0.3, 1.0]
-[[material]]
-kind = "conductor"
-[[material]]
-kind = "dielectric"
-eta = 1.5
-[incident]
-theta_deg = [0, 60]
-[detector]
-cos_theta_bins = 8
-phi_bins = 16
-"#;
+use common::CASES;
 
 fn smithwalk(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_smithwalk")).args(args).output().unwrap()

@@ -31,10 +31,10 @@ use crate::analysis::models::{
 };
 use crate::analysis::stats::{self, ChiSquare, WeightedBin};
 use crate::atomic::write_atomically;
-use crate::engine::detector::{Detector, Grid, Hemisphere};
+use crate::engine::detector::{Detector, Hemisphere};
 use crate::engine::run::{CaseResult, ChainModel, Estimator, Shard};
 use crate::engine::{RunOptions, Simulation};
-use crate::io::output::{CASE_COLUMNS, case_fields, hemisphere_sign, hemispheres};
+use crate::io::output::{CASE_COLUMNS, bin_edges, case_fields, hemisphere_sign, hemispheres};
 use crate::io::rundir::{BinValue, LobeId, Lobes, RunDir};
 use crate::setup::cases::Case;
 use crate::setup::config::{Config, Model};
@@ -89,6 +89,12 @@ impl CompareOptions {
 /// measurement or of the model's code) rather than a measure of an approximation.
 pub fn is_exact_oracle(model: Model) -> bool {
     matches!(model, Model::Single | Model::HeitzNee | Model::ExactPositionFree)
+}
+
+/// Whether a model is estimated by a Monte Carlo walk (with its own standard errors), not
+/// integrated in closed form.
+fn is_monte_carlo(model: Model) -> bool {
+    !matches!(model, Model::Single | Model::HammonFit)
 }
 
 /// One model's verdict on a run.
@@ -431,11 +437,11 @@ fn cpu_seconds() -> f64 {
     t.tv_sec as f64 + 1e-9 * t.tv_nsec as f64
 }
 
-/// A model's value in `models.csv`: six significant digits (a closed-form model's bins are
-/// accurate to 0.05 of the measured standard error, a Monte Carlo model's to its own), and a
-/// zero as `0`.
-fn short(v: f64) -> String {
-    if v == 0.0 { "0".to_string() } else { format!("{v:.5e}") }
+/// A number of `models.csv` to `digits` significant digits, and a zero as `0`: six for an
+/// energy (a closed-form model's bins are accurate to 0.05 of the measured standard error, a
+/// Monte Carlo model's to its own), three for a standard error (an error bar).
+fn significant(v: f64, digits: usize) -> String {
+    if v == 0.0 { "0".to_string() } else { format!("{v:.*e}", digits - 1) }
 }
 
 /// [`compare_with`] at the default family level: the report to print.
@@ -470,13 +476,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
             .map_or(Value::default(), |r| Value { energy: r.albedo, stderr: r.albedo_stderr })
     };
     let terminal = std::io::stderr().is_terminal();
-    let mut model_rows = csv::Writer::from_writer(Vec::new());
-    let mut header = vec!["case", "model", "order", "hemisphere"];
-    if rgb {
-        header.push("channel");
-    }
-    header.extend(["cos_lo", "cos_hi", "phi_lo_deg", "phi_hi_deg", "energy", "energy_stderr", "bsdf", "folded"]);
-    model_rows.write_record(&header)?;
+    let mut predicted: Vec<(Model, Vec<ModelLobe>)> = Vec::new();
     let mut comparisons = Vec::new();
     let mut notes: Vec<(Model, String)> = Vec::new();
     let mut skipped: Vec<(Model, String)> = Vec::new();
@@ -520,14 +520,11 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
                 ),
             ));
         }
-        let model_photons = if matches!(model, Model::Single | Model::HammonFit) { 0 } else { config.paths };
+        let model_photons = if is_monte_carlo(model) { config.paths } else { 0 };
         for lobe in &predictions.lobes {
-            let case = &run.cases[lobe.case];
             let h = hemisphere_name(lobe.hemisphere);
             let id: LobeId = (lobe.case, lobe.order, h.clone(), lobe.channel);
             let bins = measured.get(lobe.case, lobe.order, &h, lobe.channel).unwrap_or(&empty);
-            let is_folded = folded == Some(lobe.order);
-            write_model_rows(&mut model_rows, &run.grid, (case, bins), (model, lobe, is_folded), rgb)?;
             if !is_tested(&config, lobe.order) {
                 continue;
             }
@@ -542,6 +539,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
                 albedo_model,
             });
         }
+        predicted.push((model, predictions.lobes));
         let tested = comparisons.iter().filter(|c| c.model == model).count();
         eprintln!(
             "compare: {} done: {tested} lobes in {:.1} s ({:.1} CPU s)",
@@ -565,7 +563,8 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
         })
         .collect();
     let compare_csv = compare_table(&comparisons, &run, &verdicts, options.family_level, rgb, folded)?;
-    write_atomically(run_dir, &[("models.csv", model_rows.into_inner()?), ("compare.csv", compare_csv)])?;
+    let models_csv = models_table(&run, &predicted, rgb, folded)?;
+    write_atomically(run_dir, &[("models.csv", models_csv), ("compare.csv", compare_csv)])?;
     let report = report(&comparisons, &verdicts, &notes, options.family_level, rgb, folded);
     Ok(Outcome { report, verdicts })
 }
@@ -578,41 +577,81 @@ fn channel_index(channel: Option<&str>) -> usize {
     }
 }
 
-/// The rows of one model lobe in `models.csv`: one per bin of the lobe in `lobes.csv` (whose
-/// `measured` values are given) that the run or the model put energy into; the bins left out
-/// are zero in both. The case is named by its index (its parameters are in `compare.csv`,
-/// `lobes.csv` and `summary.csv`).
-fn write_model_rows(
-    w: &mut csv::Writer<Vec<u8>>,
-    grid: &Grid,
-    (case, measured): (&Case, &[BinValue]),
-    (model, lobe, folded): (Model, &ModelLobe, bool),
+/// The text of `models.csv`, row for row aligned with `lobes.csv`: its rows (every case,
+/// order slot, hemisphere, bin and channel of the run, in its order) with their key columns and
+/// `folded`, then per model compared, in that order, its energy (six significant digits) and
+/// standard error (three: an error bar), both empty where the model gives no lobe
+/// ([`model_lobe`]). A model's lobe for a slot the run does not have (no light reached that
+/// order) is not written.
+fn models_table(
+    run: &RunDir,
+    predicted: &[(Model, Vec<ModelLobe>)],
     rgb: bool,
-) -> Result<()> {
-    let sign = hemisphere_sign(case.side, lobe.hemisphere);
-    for ic in 0..grid.cos_bins {
-        let (lo, hi) = grid.cos_edges(ic);
-        let (cos_lo, cos_hi) = if sign > 0.0 { (lo, hi) } else { (-hi, -lo) };
-        let solid = grid.projected_solid_angle(ic);
-        for ip in 0..grid.phi_bins {
-            let bin = ic * grid.phi_bins + ip;
-            let (e, se) = (lobe.energy[bin], lobe.stderr[bin]);
-            if e == 0.0 && se == 0.0 && measured[bin].energy == 0.0 {
-                continue;
+    folded: Option<usize>,
+) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<String> = ["case", "order", "hemisphere"].map(String::from).into();
+    if rgb {
+        header.push("channel".into());
+    }
+    header.extend(["cos_lo", "cos_hi", "phi_lo_deg", "phi_hi_deg", "folded"].map(String::from));
+    for (model, _) in predicted {
+        header.extend([model.name().to_string(), format!("{}_stderr", model.name())]);
+    }
+    w.write_record(&header)?;
+    let channels = if rgb { 3 } else { 1 };
+    let zeros = vec![0.0; run.grid.bins()];
+    let mut row: Vec<String> = Vec::with_capacity(header.len());
+    for case in &run.cases {
+        for order in 0..run.slots[case.index] {
+            for &h in hemispheres(case) {
+                // Per channel, each model's energies and standard errors, if it gives the lobe.
+                let lobes: Vec<Vec<LobeCells>> = (0..channels)
+                    .map(|c| predicted.iter().map(|p| model_lobe(p, (case.index, order, h, c), &zeros)).collect())
+                    .collect();
+                for (_, bin, edges) in bin_edges(run.grid, hemisphere_sign(case.side, h)) {
+                    for (c, models) in lobes.iter().enumerate() {
+                        row.clear();
+                        row.extend([case.index.to_string(), order.to_string(), hemisphere_name(h)]);
+                        if rgb {
+                            row.push(channel_name(rgb, c).to_string());
+                        }
+                        row.extend(edges.map(|e| e.to_string()));
+                        row.push((folded == Some(order)).to_string());
+                        for lobe in models {
+                            match lobe {
+                                Some((e, se)) => row.extend([significant(e[bin], 6), significant(se[bin], 3)]),
+                                None => row.extend([String::new(), String::new()]),
+                            }
+                        }
+                        w.write_record(&row)?;
+                    }
+                }
             }
-            let (phi_lo, phi_hi) = grid.phi_edges_deg(ip);
-            let mut row = vec![case.index.to_string(), model.name().to_string(), lobe.order.to_string()];
-            row.push(hemisphere_name(lobe.hemisphere));
-            if rgb {
-                row.push(channel_name(rgb, lobe.channel).to_string());
-            }
-            row.extend([cos_lo, cos_hi, phi_lo, phi_hi].map(|b| b.to_string()));
-            row.extend([e, se, e / solid].map(short));
-            row.push(folded.to_string());
-            w.write_record(&row)?;
         }
     }
-    Ok(())
+    Ok(w.into_inner()?)
+}
+
+/// A model's energies and standard errors of one lobe, bin by bin, if it gives the lobe.
+type LobeCells<'a> = Option<(&'a [f64], &'a [f64])>;
+
+/// A model's energies and standard errors of a lobe (case, order slot, hemisphere, channel),
+/// or `None` if it does not give it; zero for a Monte Carlo model whose walk reached no light at
+/// that order of a case it applies to.
+fn model_lobe<'a>(
+    (model, lobes): &'a (Model, Vec<ModelLobe>),
+    lobe: (usize, usize, Hemisphere, usize),
+    zeros: &'a [f64],
+) -> LobeCells<'a> {
+    let (case, _, _, channel) = lobe;
+    match lobes.iter().find(|l| (l.case, l.order, l.hemisphere, l.channel) == lobe) {
+        Some(l) => Some((&l.energy, &l.stderr)),
+        None if is_monte_carlo(*model) && lobes.iter().any(|l| (l.case, l.channel) == (case, channel)) => {
+            Some((zeros, zeros))
+        }
+        None => None,
+    }
 }
 
 /// The text of `compare.csv`: one row per tested lobe and model.

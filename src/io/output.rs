@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use crate::atomic::write_atomically;
 use crate::engine::Simulation;
-use crate::engine::detector::{Detector, Hemisphere, Moments, Tally};
+use crate::engine::detector::{Detector, Grid, Hemisphere, Moments, Tally};
 use crate::engine::run::CaseResult;
 use crate::setup::cases::Case;
 use crate::setup::config::{Config, IncidentSide, NormalsKind, SmithKind};
@@ -229,39 +229,49 @@ fn channel_header(rgb: bool) -> Vec<&'static str> {
     if rgb { vec!["channel"] } else { vec![] }
 }
 
+/// The bins of a lobe in the order of `lobes.csv` (and `models.csv`): cos index, then phi
+/// index, each as `(cos index, bin index, [cos_lo, cos_hi, phi_lo_deg, phi_hi_deg])` with the
+/// cos edges signed by the hemisphere's `sign` ([`hemisphere_sign`]).
+pub(crate) fn bin_edges(grid: Grid, sign: f64) -> impl Iterator<Item = (usize, usize, [f64; 4])> {
+    (0..grid.cos_bins).flat_map(move |ic| {
+        let (lo, hi) = grid.cos_edges(ic);
+        let (cos_lo, cos_hi) = if sign > 0.0 { (lo, hi) } else { (-hi, -lo) };
+        (0..grid.phi_bins).map(move |ip| {
+            let (phi_lo, phi_hi) = grid.phi_edges_deg(ip);
+            (ic, ic * grid.phi_bins + ip, [cos_lo, cos_hi, phi_lo, phi_hi])
+        })
+    })
+}
+
 fn lobe_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &Detector<C>) -> Result<()> {
     let fields = case_fields(case);
     let grid = d.grid;
     let n = d.tallies.photons;
     for (slot, tallies) in d.tallies.orders.iter().enumerate() {
         for &hemisphere in hemispheres(case) {
-            let sign = hemisphere_sign(case.side, hemisphere);
-            for ic in 0..grid.cos_bins {
+            for (ic, bin, edges) in bin_edges(grid, hemisphere_sign(case.side, hemisphere)) {
+                let [cos_lo, cos_hi, phi_lo, phi_hi] = edges;
                 let (lo, hi) = grid.cos_edges(ic);
-                let (cos_lo, cos_hi) = if sign > 0.0 { (lo, hi) } else { (-hi, -lo) };
                 let projected = grid.projected_solid_angle(ic);
                 // The bin's centre: the mid-point in cos theta (it halves the bin's solid angle)
                 // and in phi; the solid angle is delta phi times delta cos (§4.7).
                 let theta_deg = (0.5 * (cos_lo + cos_hi)).acos().to_degrees();
                 let solid_angle = (hi - lo) * std::f64::consts::TAU / grid.phi_bins as f64;
-                for ip in 0..grid.phi_bins {
-                    let (phi_lo, phi_hi) = grid.phi_edges_deg(ip);
-                    let tally = &tallies.bins[hemisphere as usize * grid.bins() + ic * grid.phi_bins + ip];
-                    for (c, channel) in CHANNEL_NAMES.iter().enumerate().take(C) {
-                        let (energy, se) = tally.mean_and_stderr(n, c);
-                        let mut row = fields.clone();
-                        row.push(slot.to_string());
-                        row.push(format!("{hemisphere:?}"));
-                        if C > 1 {
-                            row.push(channel.to_string());
-                        }
-                        row.extend([cos_lo, cos_hi, phi_lo, phi_hi, energy, se].map(|v| v.to_string()));
-                        row.push(tally.count.to_string());
-                        row.push((energy / projected).to_string());
-                        row.push((se / projected).to_string());
-                        row.extend([theta_deg, 0.5 * (phi_lo + phi_hi), solid_angle].map(|v| v.to_string()));
-                        w.write_record(&row)?;
+                let tally = &tallies.bins[hemisphere as usize * grid.bins() + bin];
+                for (c, channel) in CHANNEL_NAMES.iter().enumerate().take(C) {
+                    let (energy, se) = tally.mean_and_stderr(n, c);
+                    let mut row = fields.clone();
+                    row.push(slot.to_string());
+                    row.push(format!("{hemisphere:?}"));
+                    if C > 1 {
+                        row.push(channel.to_string());
                     }
+                    row.extend([cos_lo, cos_hi, phi_lo, phi_hi, energy, se].map(|v| v.to_string()));
+                    row.push(tally.count.to_string());
+                    row.push((energy / projected).to_string());
+                    row.push((se / projected).to_string());
+                    row.extend([theta_deg, 0.5 * (phi_lo + phi_hi), solid_angle].map(|v| v.to_string()));
+                    w.write_record(&row)?;
                 }
             }
         }

@@ -5,7 +5,9 @@
 //! A run directory is validated before any of it is used ([`RunDir::open`]): the tables must be
 //! the ones `run.json` records (SHA-256 digests: nothing changed them, and they belong to the
 //! same run), complete (every case, order slot, hemisphere, channel and bin exactly once) and
-//! finite, with non-negative energies. Otherwise the reader gets one error and writes nothing.
+//! finite, with non-negative energies. `models.csv`, when a command reads it, must hold the rows
+//! of `lobes.csv` in the same order (the same key columns), with finite non-negative values.
+//! Otherwise the reader gets one error and writes nothing.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -220,42 +222,144 @@ fn complete(seen: &[bool], path: &Path, describe: impl Fn(usize) -> String) -> R
     Ok(())
 }
 
-/// Checks that `lobes.csv` has every case, slot, hemisphere, channel and bin exactly once, with
-/// finite non-negative energies and BSDF values. Columns are found by name; others are allowed.
-fn check_lobes(path: &Path, shape: &Shape) -> Result<()> {
-    let table = Table::read(path)?;
-    let col = |name| table.column(name);
-    let (case_c, order_c, hemi_c) = (col("case")?, col("order")?, col("hemisphere")?);
-    let (cos_lo_c, cos_hi_c, phi_c) = (col("cos_lo")?, col("cos_hi")?, col("phi_lo_deg")?);
-    let values = ["energy", "energy_stderr", "bsdf", "bsdf_stderr"].map(|n| col(n).map(|c| (n, c)));
-    let channel_c = table.column("channel").ok();
-    let (grid, channels) = (shape.grid, shape.channels);
-    let (offsets, mut seen) =
-        shape.rows(&table, |hemispheres, slots| slots.saturating_mul(hemispheres * grid.bins() * channels))?;
-    for (line, r) in table.records.iter().enumerate() {
-        let at = || format!("{} line {}", path.display(), line + 2);
-        let (case, slots) = shape.case_of(r, case_c, &at)?;
-        let order = index(r, order_c, "order", &at)?;
+/// The key columns of a table with one row per bin of the run (`lobes.csv`, `models.csv`),
+/// found by name.
+struct BinKeys {
+    case: usize,
+    order: usize,
+    hemisphere: usize,
+    channel: Option<usize>,
+    cos_lo: usize,
+    cos_hi: usize,
+    phi_lo: usize,
+}
+
+/// Where a row of a bin table belongs: its position in the run's order (case, slot,
+/// hemisphere, bin, channel: the order of `lobes.csv`), its lobe and its bin in the lobe.
+struct BinKey {
+    row: usize,
+    lobe: LobeId,
+    cos_index: usize,
+    bin: usize,
+}
+
+impl BinKeys {
+    fn of(table: &Table) -> Result<Self> {
+        let col = |name| table.column(name);
+        Ok(Self {
+            case: col("case")?,
+            order: col("order")?,
+            hemisphere: col("hemisphere")?,
+            channel: table.column("channel").ok(),
+            cos_lo: col("cos_lo")?,
+            cos_hi: col("cos_hi")?,
+            phi_lo: col("phi_lo_deg")?,
+        })
+    }
+
+    /// The key of row `r`, given the first row of each case (`offsets`); an error if it is
+    /// not a bin of the run.
+    fn key(&self, r: &csv::StringRecord, shape: &Shape, offsets: &[usize], at: &dyn Fn() -> String) -> Result<BinKey> {
+        let (case, slots) = shape.case_of(r, self.case, at)?;
+        let order = index(r, self.order, "order", at)?;
         if order >= slots {
             bail!("{}: order {order} is not a slot of case {case} ({slots} slots)", at());
         }
         let hemispheres = shape.hemispheres(case);
-        let h = hemisphere_of(r.get(hemi_c), hemispheres, &at)?;
-        let c = channel_of(r, channel_c, channels, &at)?;
+        let h = hemisphere_of(r.get(self.hemisphere), hemispheres, at)?;
+        let (grid, channels) = (shape.grid, shape.channels);
+        let c = channel_of(r, self.channel, channels, at)?;
         let (lo, hi, phi) = (
-            number(r, cos_lo_c, "cos_lo", false, &at)?,
-            number(r, cos_hi_c, "cos_hi", false, &at)?,
-            number(r, phi_c, "phi_lo_deg", false, &at)?,
+            number(r, self.cos_lo, "cos_lo", false, at)?,
+            number(r, self.cos_hi, "cos_hi", false, at)?,
+            number(r, self.phi_lo, "phi_lo_deg", false, at)?,
         );
         let (ic, ip) = bin_of(grid, lo, hi, phi).with_context(|| format!("{}: a bin outside the run's grid", at()))?;
+        let bin = ic * grid.phi_bins + ip;
+        Ok(BinKey {
+            row: offsets[case] + ((order * hemispheres + h) * grid.bins() + bin) * channels + c,
+            lobe: (case, order, ["R", "T"][h].to_string(), c),
+            cos_index: ic,
+            bin,
+        })
+    }
+}
+
+/// Rows of `lobes.csv` of a case with `hemispheres` hemispheres and `slots` order slots.
+fn lobe_rows(shape: &Shape, hemispheres: usize, slots: usize) -> usize {
+    slots.saturating_mul(hemispheres * shape.grid.bins() * shape.channels)
+}
+
+/// Checks that `lobes.csv` has every case, slot, hemisphere, channel and bin exactly once, with
+/// finite non-negative energies and BSDF values. Columns are found by name; others are allowed.
+fn check_lobes(path: &Path, shape: &Shape) -> Result<()> {
+    let table = Table::read(path)?;
+    let keys = BinKeys::of(&table)?;
+    let values = ["energy", "energy_stderr", "bsdf", "bsdf_stderr"].map(|n| table.column(n).map(|c| (n, c)));
+    let (offsets, mut seen) = shape.rows(&table, |hemispheres, slots| lobe_rows(shape, hemispheres, slots))?;
+    for (line, r) in table.records.iter().enumerate() {
+        let at = || format!("{} line {}", path.display(), line + 2);
+        let key = keys.key(r, shape, &offsets, &at)?;
         for v in &values {
             let (name, column) = v.as_ref().map_err(|e| anyhow::anyhow!("{e}"))?;
             number(r, *column, name, true, &at)?;
         }
-        let key = offsets[case] + ((order * hemispheres + h) * grid.bins() + ic * grid.phi_bins + ip) * channels + c;
-        mark(&mut seen, key, &at)?;
+        mark(&mut seen, key.row, &at)?;
     }
     complete(&seen, path, |k| format!("row {k} in the run's order"))
+}
+
+/// The models of `models.csv`: each column `<name>` with a column `<name>_stderr`, as
+/// `(name, energy column, standard error column)` in the order of the header.
+fn model_columns(headers: &csv::StringRecord) -> Vec<(String, usize, usize)> {
+    headers
+        .iter()
+        .enumerate()
+        .filter_map(|(i, name)| {
+            let stderr = format!("{name}_stderr");
+            headers.iter().position(|h| h == stderr).map(|j| (name.to_string(), i, j))
+        })
+        .collect()
+}
+
+/// Reads `models.csv` into lobes per model, once it is checked to hold the rows of `lobes.csv`
+/// in their order (by their key columns), each model's cells both empty (the model gives no
+/// such lobe) or both finite and non-negative. A model's BSDF is its energy over the bin's
+/// projected solid angle, as in `lobes.csv`.
+fn read_models(path: &Path, shape: &Shape) -> Result<HashMap<String, Lobes>> {
+    let table = Table::read(path)?;
+    let keys = BinKeys::of(&table)?;
+    let models = model_columns(&table.headers);
+    let (offsets, _) = shape.rows(&table, |hemispheres, slots| lobe_rows(shape, hemispheres, slots))?;
+    let mut out: HashMap<String, Lobes> = HashMap::new();
+    for (line, r) in table.records.iter().enumerate() {
+        let at = || format!("{} line {}", path.display(), line + 2);
+        let key = keys.key(r, shape, &offsets, &at)?;
+        if key.row != line {
+            bail!(
+                "{}: not the bin of lobes.csv's line {} (models.csv has the rows of lobes.csv, in its order)",
+                at(),
+                line + 2
+            );
+        }
+        let projected = shape.grid.projected_solid_angle(key.cos_index);
+        for (name, energy_c, stderr_c) in &models {
+            match (r.get(*energy_c), r.get(*stderr_c)) {
+                (Some(""), Some("")) => continue,
+                (Some(""), _) | (_, Some("")) => {
+                    bail!("{}: {name} and {name}_stderr must be both empty (no lobe) or both numbers", at())
+                }
+                _ => {}
+            }
+            let energy = number(r, *energy_c, name, true, &at)?;
+            let stderr = number(r, *stderr_c, &format!("{name}_stderr"), true, &at)?;
+            let lobes = &mut out.entry(name.clone()).or_default().lobes;
+            let bins = lobes.entry(key.lobe.clone()).or_insert_with(|| vec![BinValue::default(); shape.grid.bins()]);
+            bins[key.bin] =
+                BinValue { energy, energy_stderr: stderr, bsdf: energy / projected, bsdf_stderr: stderr / projected };
+        }
+    }
+    Ok(out)
 }
 
 /// The bin `(cos index, phi index)` of a row, from the centre of its `|cos|` range and its
@@ -340,8 +444,6 @@ impl Lobes {
 #[derive(Deserialize)]
 struct BinRow {
     case: usize,
-    #[serde(default)]
-    model: Option<String>,
     order: usize,
     hemisphere: String,
     #[serde(default)]
@@ -352,8 +454,7 @@ struct BinRow {
     energy: f64,
     energy_stderr: f64,
     bsdf: f64,
-    #[serde(default)]
-    bsdf_stderr: Option<f64>,
+    bsdf_stderr: f64,
 }
 
 fn channel_index(channel: &Option<String>) -> usize {
@@ -364,15 +465,14 @@ fn channel_index(channel: &Option<String>) -> usize {
     }
 }
 
-/// Reads a bin table (`lobes.csv` or `models.csv`) into lobes per model name (`""` for the
-/// measurement).
-fn read_bins(path: &Path, grid: Grid) -> Result<HashMap<String, Lobes>> {
+/// Reads the measured lobes of `lobes.csv`.
+fn read_bins(path: &Path, grid: Grid) -> Result<Lobes> {
     let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let mut out: HashMap<String, Lobes> = HashMap::new();
+    let mut out = Lobes::default();
     for row in reader.deserialize() {
         let row: BinRow = row.with_context(|| format!("{}: bad row", path.display()))?;
-        let values = [row.cos_lo, row.cos_hi, row.phi_lo_deg, row.energy, row.energy_stderr, row.bsdf];
-        if values.iter().chain(&row.bsdf_stderr).any(|v| !v.is_finite()) {
+        let values = [row.cos_lo, row.cos_hi, row.phi_lo_deg, row.energy, row.energy_stderr, row.bsdf, row.bsdf_stderr];
+        if values.iter().any(|v| !v.is_finite()) {
             bail!("{}: a bin of case {} with a value that is not finite", path.display(), row.case);
         }
         // |cos| of the bin's centre finds its cos index in either hemisphere.
@@ -381,8 +481,7 @@ fn read_bins(path: &Path, grid: Grid) -> Result<HashMap<String, Lobes>> {
         if ic >= grid.cos_bins || ip >= grid.phi_bins {
             bail!("{}: a bin outside the run's {} x {} grid", path.display(), grid.cos_bins, grid.phi_bins);
         }
-        let lobes = out.entry(row.model.clone().unwrap_or_default()).or_default();
-        let bins = lobes
+        let bins = out
             .lobes
             .entry((row.case, row.order, row.hemisphere.clone(), channel_index(&row.channel)))
             .or_insert_with(|| vec![BinValue::default(); grid.bins()]);
@@ -390,7 +489,7 @@ fn read_bins(path: &Path, grid: Grid) -> Result<HashMap<String, Lobes>> {
             energy: row.energy,
             energy_stderr: row.energy_stderr,
             bsdf: row.bsdf,
-            bsdf_stderr: row.bsdf_stderr.unwrap_or(0.0),
+            bsdf_stderr: row.bsdf_stderr,
         };
     }
     Ok(out)
@@ -442,24 +541,33 @@ impl RunDir {
         }
         let grid = Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins };
         let slots: Vec<usize> = run.cases.iter().map(|c| c.energy.highest_order.saturating_add(1)).collect();
-        let shape = Shape { cases: &cases, slots: slots.clone(), channels: if config.is_rgb() { 3 } else { 1 }, grid };
+        let run = Self { path: path.to_path_buf(), config, cases, grid, slots, _lock: lock };
+        let shape = run.shape();
         check_lobes(&path.join(TABLES[0]), &shape)?;
         check_summary(&path.join(TABLES[1]), &shape)?;
-        Ok(Self { path: path.to_path_buf(), config, cases, grid, slots, _lock: lock })
+        Ok(run)
     }
 
     /// The measured lobes of `lobes.csv`.
     pub fn measured(&self) -> Result<Lobes> {
-        Ok(read_bins(&self.path.join("lobes.csv"), self.grid)?.remove("").unwrap_or_default())
+        read_bins(&self.path.join("lobes.csv"), self.grid)
     }
 
-    /// The model lobes of `models.csv` per model name; empty if `compare` has not run.
+    /// The model lobes of `models.csv` per model name (its columns `<name>` with a
+    /// `<name>_stderr`; a model without any lobe is absent), once the file is checked: the rows
+    /// of `lobes.csv` in its order, each model's two cells both empty or both finite numbers
+    /// >= 0. Empty if `compare` has not run.
     pub fn models(&self) -> Result<HashMap<String, Lobes>> {
         let path = self.path.join("models.csv");
         if !path.exists() {
             return Ok(HashMap::new());
         }
-        read_bins(&path, self.grid)
+        read_models(&path, &self.shape())
+    }
+
+    fn shape(&self) -> Shape<'_> {
+        let channels = if self.config.is_rgb() { 3 } else { 1 };
+        Shape { cases: &self.cases, slots: self.slots.clone(), channels, grid: self.grid }
     }
 
     /// For exports of reflection only: a one-line note of the transmission they drop (the

@@ -8,6 +8,25 @@ use smithwalk::engine::run::CaseResult;
 use smithwalk::microsurface::DVec3;
 use smithwalk::setup::config::Config;
 
+/// Both facet kinds (a conductor, and a dielectric that transmits) at two roughnesses and two
+/// incident angles on an 8 x 16 grid, seed 11, without `paths` and `max_order` (the tests add
+/// them, `paths` before and `max_order` after).
+pub const CASES: &str = r#"
+seed = 11
+[surface]
+alpha = [0.3, 1.0]
+[[material]]
+kind = "conductor"
+[[material]]
+kind = "dielectric"
+eta = 1.5
+[incident]
+theta_deg = [0, 60]
+[detector]
+cos_theta_bins = 8
+phi_bins = 16
+"#;
+
 /// The `smithwalk` binary with `args`, its output discarded.
 pub fn smithwalk_quiet(args: &[&str]) -> std::process::Command {
     let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_smithwalk"));

@@ -126,6 +126,14 @@ impl BinArrays {
         }
     }
 
+    /// The flat index of bin `bin` (`cos index * phi_bins + phi index`) and `channel` of the
+    /// lobe `[case, order, hemisphere]`.
+    fn at(&self, [case, order, hemisphere]: [usize; 3], bin: usize, channel: usize) -> usize {
+        let (orders, bins, channels) =
+            (self.shape[1], self.shape[3] * self.shape[4], self.shape.get(5).map_or(1, |c| *c));
+        (((case * orders + order) * 2 + hemisphere) * bins + bin) * channels + channel
+    }
+
     fn into_dict<'py>(self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let dict = PyDict::new(py);
         let shape = self.shape;
@@ -152,14 +160,13 @@ const MEASURED: [&str; 4] = ["energy", "energy_stderr", "bsdf", "bsdf_stderr"];
 /// projected solid angles that `lobes.csv` is written from.
 fn fill<const C: usize>(d: &Detector<C>, case: usize, arrays: &mut BinArrays) {
     let grid = d.grid;
-    let orders = arrays.shape[1];
     let n = d.tallies.photons;
     for (slot, tallies) in d.tallies.orders.iter().enumerate() {
         for (i, tally) in tallies.bins.iter().enumerate() {
             // `i` runs over hemisphere, cos bin and phi bin, the arrays' next three axes.
             let solid = grid.projected_solid_angle(i % grid.bins() / grid.phi_bins);
             for c in 0..C {
-                let at = ((case * orders + slot) * 2 * grid.bins() + i) * C + c;
+                let at = arrays.at([case, slot, 0], i, c);
                 let (energy, se) = tally.mean_and_stderr(n, c);
                 for (name, value) in MEASURED.into_iter().zip([energy, se, energy / solid, se / solid]) {
                     arrays.columns.get_mut(name).expect("a measured column")[at] = value;
@@ -229,10 +236,9 @@ fn read_config(dir: PathBuf) -> PyResult<String> {
     serde_json::to_string(&config).map_err(|e| runtime_error(e.into()))
 }
 
-/// The columns of a bin table (`lobes.csv` or `models.csv`) that [`read_bins`] needs.
+/// The columns of `lobes.csv` that [`read_lobes`] needs.
 struct BinColumns {
     case: usize,
-    model: Option<usize>,
     order: usize,
     hemisphere: usize,
     channel: Option<usize>,
@@ -253,7 +259,6 @@ impl BinColumns {
             .collect();
         Ok(Self {
             case: need("case")?,
-            model: find("model"),
             order: need("order")?,
             hemisphere: need("hemisphere")?,
             channel: find("channel"),
@@ -266,9 +271,8 @@ impl BinColumns {
     }
 }
 
-/// One parsed row of a bin table: its source, position in the arrays and values.
+/// One parsed row of `lobes.csv`: its position in the arrays and values.
 struct BinRow {
-    model: String,
     index: [usize; 5],
     channel: usize,
     values: Vec<f64>,
@@ -299,7 +303,6 @@ fn parse_row(c: &BinColumns, r: &csv::StringRecord, grid: Grid) -> anyhow::Resul
         Some(other) => anyhow::bail!("channel {other:?} is not r, g or b"),
     };
     Ok(BinRow {
-        model: c.model.map_or(String::new(), |i| r[i].to_string()),
         index: [r[c.case].parse()?, r[c.order].parse()?, hemisphere, ic, ip],
         channel,
         values: c.values.iter().map(|&(_, i)| number(i)).collect::<anyhow::Result<_>>()?,
@@ -307,11 +310,11 @@ fn parse_row(c: &BinColumns, r: &csv::StringRecord, grid: Grid) -> anyhow::Resul
     })
 }
 
-/// Reads a bin table of a run with `cases` cases on a `cos_bins` x `phi_bins` grid into arrays
-/// per model name (`""` for `lobes.csv`), shaped `(case, order, hemisphere, cos_bin, phi_bin[,
-/// channel])` with as many orders as the table has; bins without a row are zero.
+/// Reads the `lobes.csv` of a run with `cases` cases on a `cos_bins` x `phi_bins` grid into
+/// arrays shaped `(case, order, hemisphere, cos_bin, phi_bin[, channel])` with as many orders
+/// as the table has; bins without a row are zero.
 #[pyfunction]
-fn read_bins<'py>(
+fn read_lobes<'py>(
     py: Python<'py>,
     path: PathBuf,
     cases: usize,
@@ -331,32 +334,52 @@ fn read_bins<'py>(
                     .with_context(|| format!("{}: row {}", path.display(), line + 2))
             })
             .collect::<anyhow::Result<Vec<_>>>()?;
-        let mut by_model: BTreeMap<String, Vec<BinRow>> = BTreeMap::new();
-        for row in rows {
-            anyhow::ensure!(row.index[0] < cases, "{}: case {} of a run with {cases}", path.display(), row.index[0]);
-            by_model.entry(row.model.clone()).or_default().push(row);
-        }
         let names: Vec<&'static str> = columns.values.iter().map(|&(name, _)| name).collect();
         let channels = columns.channel.map(|_| 3);
-        Ok(by_model
-            .into_iter()
-            .map(|(model, rows)| {
-                let orders = rows.iter().map(|r| r.index[1] + 1).max().unwrap_or(1);
-                let mut arrays = BinArrays::new(shape(cases, orders, grid, channels), &names, columns.count.is_some());
-                for row in rows {
-                    let [case, order, hemisphere, ic, ip] = row.index;
-                    let bin = ((((case * orders + order) * 2 + hemisphere) * cos_bins + ic) * phi_bins) + ip;
-                    let at = bin * channels.unwrap_or(1) + row.channel;
-                    for (&name, value) in names.iter().zip(row.values) {
-                        arrays.columns.get_mut(name).expect("a parsed column")[at] = value;
-                    }
-                    if let Some(count) = arrays.count.as_mut() {
-                        count[at] = row.count;
+        let orders = rows.iter().map(|r| r.index[1] + 1).max().unwrap_or(1);
+        let mut arrays = BinArrays::new(shape(cases, orders, grid, channels), &names, columns.count.is_some());
+        for row in rows {
+            let [case, order, hemisphere, ic, ip] = row.index;
+            anyhow::ensure!(case < cases, "{}: case {case} of a run with {cases}", path.display());
+            let at = arrays.at([case, order, hemisphere], ic * phi_bins + ip, row.channel);
+            for (&name, value) in names.iter().zip(row.values) {
+                arrays.columns.get_mut(name).expect("a parsed column")[at] = value;
+            }
+            if let Some(count) = arrays.count.as_mut() {
+                count[at] = row.count;
+            }
+        }
+        Ok(arrays)
+    });
+    parsed.map_err(|e| PyValueError::new_err(message(e)))?.into_dict(py)
+}
+
+/// The models' lobes of the run directory `dir`, from its `models.csv` as the command line
+/// reads and checks it (`RunDir::models`): per model name `energy`, `energy_stderr` and `bsdf`,
+/// arrays shaped like the run's `(case, order, hemisphere, cos_bin, phi_bin[, channel])` with
+/// the run's order slots; lobes the model does not give are zero.
+#[pyfunction]
+fn read_models<'py>(py: Python<'py>, dir: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    const MODEL: [&str; 3] = ["energy", "energy_stderr", "bsdf"];
+    let parsed = py.detach(|| -> anyhow::Result<_> {
+        let run = smithwalk::io::rundir::RunDir::open(&dir)?;
+        let orders = run.slots.iter().copied().max().unwrap_or(1);
+        let channels = run.config.is_rgb().then_some(3);
+        let mut out = BTreeMap::new();
+        for (model, lobes) in run.models()? {
+            let mut arrays = BinArrays::new(shape(run.cases.len(), orders, run.grid, channels), &MODEL, false);
+            for ((case, order, hemisphere, channel), bins) in lobes.lobes {
+                let lobe = [case, order, usize::from(hemisphere == "T")];
+                for (bin, v) in bins.iter().enumerate() {
+                    let at = arrays.at(lobe, bin, channel);
+                    for (name, value) in MODEL.into_iter().zip([v.energy, v.energy_stderr, v.bsdf]) {
+                        arrays.columns.get_mut(name).expect("a model column")[at] = value;
                     }
                 }
-                (model, arrays)
-            })
-            .collect::<Vec<_>>())
+            }
+            out.insert(model, arrays);
+        }
+        Ok(out)
     });
     let dict = PyDict::new(py);
     for (model, arrays) in parsed.map_err(|e| PyValueError::new_err(message(e)))? {
@@ -432,7 +455,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<NativeRun>()?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(read_config, m)?)?;
-    m.add_function(wrap_pyfunction!(read_bins, m)?)?;
+    m.add_function(wrap_pyfunction!(read_lobes, m)?)?;
+    m.add_function(wrap_pyfunction!(read_models, m)?)?;
     m.add_function(wrap_pyfunction!(grid, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(write_files, m)?)?;

@@ -163,6 +163,8 @@ def test_compare_matches_the_command_line(cli, tmp_path):
     # Exact single scattering has order 1 only, for every case.
     single = comparison["single"]["energy"]
     assert single[:, 1].any() and not single[:, 2:].any()
+    # models.csv carries energies only; the BSDF is the energy over the projected solid angle.
+    assert np.array_equal(comparison["single"]["bsdf"], single / result.projected_solid_angle[:, None])
     table = comparison.table
     assert set(table["model"]) == {"single", "wang-correlated"}
     assert "wang-correlated" in comparison.report
@@ -174,6 +176,11 @@ def test_compare_matches_the_command_line(cli, tmp_path):
     cli("compare", tmp_path / "cli", "--models", "single,wang-correlated", "--paths", 20_000)
     for name in ("models.csv", "compare.csv"):
         assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
+    # models.csv: lobes.csv's rows, then a value and a standard error per model, in order.
+    header = (tmp_path / "py" / "models.csv").read_text().split("\n", 1)[0].split(",")
+    assert header[-4:] == ["single", "single_stderr", "wang-correlated", "wang-correlated_stderr"]
+    lines = [(tmp_path / "py" / name).read_text().count("\n") for name in ("models.csv", "lobes.csv")]
+    assert lines[0] == lines[1]
     # And a loaded run carries its comparison.
     loaded = smithwalk.load(tmp_path / "py")
     assert loaded.comparison.models == ("single", "wang-correlated")
@@ -269,3 +276,30 @@ def test_the_example_runs_and_plots(tmp_path):
     assert image[..., :3].std() > 0.05  # drawn, not blank
     assert (tmp_path / "run" / "compare.csv").exists()
     assert "wang-correlated" in done.stdout
+
+
+def test_plot_lobes_draws_the_models_of_models_csv(tmp_path):
+    pytest.importorskip("matplotlib")
+    result = smithwalk.run(MONO, paths=5_000)
+    result.compare(["single", "heitz-nee"], paths=5_000, threads=2)
+    result.save(tmp_path / "run")
+    script = REPO / "scripts" / "plot_lobes.py"
+    lobes = tmp_path / "run" / "lobes.csv"
+    done = subprocess.run(
+        [sys.executable, str(script), str(lobes), "--out", str(tmp_path / "l.png")],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    for name in ("l_g0_R.png", "l_g2_T.png"):
+        assert f"{name} with heitz-nee, single" in done.stderr, done.stderr
+        assert (tmp_path / name).exists()
+    # A models.csv that is not beside this lobes.csv row for row is refused.
+    short = tmp_path / "short.csv"
+    short.write_text("\n".join((tmp_path / "run" / "models.csv").read_text().split("\n")[:100]) + "\n")
+    refused = subprocess.run(
+        [sys.executable, str(script), str(lobes), "--models", str(short), "--out", str(tmp_path / "x.png")],
+        capture_output=True,
+        text=True,
+    )
+    assert refused.returncode != 0 and "not the models of this run" in refused.stderr

@@ -121,19 +121,6 @@ def _column(values):
     return np.array(values, dtype=str)
 
 
-def _pad_orders(arrays, orders):
-    """Pads the order axis of every array with zeros to at least `orders` slots."""
-    out = {}
-    for name, a in arrays.items():
-        missing = orders - a.shape[1]
-        if missing > 0:
-            pad = [(0, 0)] * a.ndim
-            pad[1] = (0, missing)
-            a = np.pad(a, pad)
-        out[name] = a
-    return out
-
-
 class Comparison:
     """A run compared with analytic models (the result of :meth:`RunResult.compare`).
 
@@ -146,10 +133,12 @@ class Comparison:
         of the measured lobe against the model's (``chi2``, ``dof``, ``p_value``), the lobes'
         relative L1 and L2 differences and both albedos with standard errors.
     lobes : dict of str to dict of numpy.ndarray
-        Per model name the model's lobes from ``models.csv``, ``energy``, ``energy_stderr``
-        (0 for closed-form models) and ``bsdf``, float64 arrays shaped like the run's
-        (``(case, order, hemisphere, cos_bin, phi_bin[, channel])``; the order axis has at
-        least the run's slots). Cases and orders a model does not apply to are zero.
+        Per model name the model's lobes from ``models.csv`` (its columns ``<model>`` and
+        ``<model>_stderr``, row for row beside ``lobes.csv``): ``energy``, ``energy_stderr``
+        (0 for closed-form models) and ``bsdf`` (``energy`` over the bin's projected solid
+        angle), float64 arrays shaped like the run's (``(case, order, hemisphere, cos_bin,
+        phi_bin[, channel])``). Cases, orders and channels a model does not give are zero; a
+        model that gives no lobe at all (``single`` with ``max_order = 1``) is absent.
     report : str
         The text ``smithwalk compare`` prints: the worst lobes per model.
     """
@@ -302,9 +291,7 @@ class RunResult:
                 tmp, models, _unsigned("paths", paths), _unsigned("threads", threads)
             )
             files = {name: (Path(tmp) / name).read_bytes() for name in _COMPARE_FILES}
-            cos_bins, phi_bins = len(self.cos_edges) - 1, len(self.phi_edges_deg) - 1
-            by_model = _native.read_bins(Path(tmp) / "models.csv", len(self.cases), cos_bins, phi_bins)
-        lobes = {m: _pad_orders(by_model.get(m, {}), self.energy.shape[1]) for m in by_model}
+            lobes = _native.read_models(tmp)
         self.comparison = Comparison(models, files, lobes, report)
         return self.comparison
 
@@ -433,19 +420,20 @@ def load(path):
     detector = config["detector"]
     cos_bins, phi_bins = detector["cos_theta_bins"], detector["phi_bins"]
     cases = len(info["cases"])
-    lobes = _native.read_bins(path / "lobes.csv", cases, cos_bins, phi_bins)[""]
+    lobes = _native.read_lobes(path / "lobes.csv", cases, cos_bins, phi_bins)
     result = RunResult(
         info=info, lobes=lobes, summary_csv=(path / "summary.csv").read_bytes(), path=path
     )
     if all((path / name).exists() for name in _COMPARE_FILES):
         files = {name: (path / name).read_bytes() for name in _COMPARE_FILES}
-        by_model = _native.read_bins(path / "models.csv", cases, cos_bins, phi_bins)
-        lobes = {m: _pad_orders(a, result.energy.shape[1]) for m, a in by_model.items()}
-        models = list(dict.fromkeys(_column_values(files["compare.csv"], "model")))
+        lobes = _native.read_models(path)
+        models = _model_names(files["models.csv"])
         result.comparison = Comparison(models, files, lobes, report="")
     return result
 
 
-def _column_values(data: bytes, name):
-    """The values of one column of a CSV table, in row order."""
-    return [row[name] for row in csv.DictReader(io.StringIO(data.decode()))]
+def _model_names(models_csv: bytes):
+    """The models of a ``models.csv``, in the order compared: each column ``<name>`` that has a
+    column ``<name>_stderr``."""
+    header = next(csv.reader([models_csv.split(b"\n", 1)[0].decode()]))
+    return [name for name in header if f"{name}_stderr" in header]
