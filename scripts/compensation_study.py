@@ -12,8 +12,7 @@ lobes.csv, and writes
   compensation-lobe.png    relative L1 error of each model's all-orders lobe against incidence,
                            with the walk's own noise floor (the L1 that noise alone gives);
 and prints a Markdown table: per model and material, the worst albedo error and where, and the
-median and worst lobe error. Models are judged on the all-orders slot (order 0), except
-`single`, shown for reference against order 0 too (the energy it loses).
+median and worst lobe error. Models are judged on the all-orders slot (order 0).
 """
 import argparse
 import math
@@ -123,7 +122,7 @@ def main():
     print("| model | material | worst albedo error (alpha, theta) | albedo error at alpha <= 0.2 | "
           "lobe rel. L1: median / worst (alpha, theta) |")
     print("|---|---|---|---|---|")
-    for model in ["single"] + MODELS:
+    for model in MODELS:
         for label, material, channel in rows:
             s = select(compare, material, channel, model)
             if s.empty:

@@ -51,7 +51,7 @@ pub struct ExternalModel {
 
 impl ExternalModel {
     /// The photon count of the model for the two-sample test: 0 (exact) without standard
-    /// errors, else [`NOMINAL_PHOTONS`].
+    /// errors, else `NOMINAL_PHOTONS`.
     pub fn photons(&self) -> u64 {
         if self.has_stderr { NOMINAL_PHOTONS } else { 0 }
     }
