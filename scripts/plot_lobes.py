@@ -40,6 +40,10 @@ MODEL_STYLE = {
     "exact-position-free": ("#d55e00", (0, (7, 2))),
     "wang-correlated": ("#e69f00", "-"),
     "wang-uncorrelated": ("#cc79a7", (0, (1, 1.5))),
+    "kulla-conty": ("#56b4e9", "-"),
+    "turquin": ("#b08c00", (0, (3.5, 2))),
+    "fdez-aguera": ("#336666", (0, (1, 1.5))),
+    "external": ("#8c510a", (0, (7, 2))),
 }
 
 

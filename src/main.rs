@@ -74,7 +74,7 @@ enum Command {
         /// The run's output directory (with run.json, lobes.csv and summary.csv).
         run_dir: PathBuf,
         /// Comma-separated models: single, hammon-fit, heitz-nee, exact-position-free,
-        /// wang-correlated, wang-uncorrelated.
+        /// wang-correlated, wang-uncorrelated, kulla-conty, turquin, fdez-aguera.
         #[arg(
             long,
             value_delimiter = ',',
@@ -96,6 +96,11 @@ enum Command {
         /// rejects a lobe, to gate code on it in CI (exit status 1 is an error).
         #[arg(long)]
         fail_on_reject: bool,
+        /// A user's own model in the run's bins, judged as `external` (CSV: case, order,
+        /// hemisphere, [channel], cos_lo, cos_hi, phi_lo_deg, phi_hi_deg, energy,
+        /// [energy_stderr]; docs/compensation.md).
+        #[arg(long)]
+        external: Option<PathBuf>,
     },
     /// Draw a run's lobes (plane of incidence per order with the models of models.csv, polar
     /// heat maps) and per-order albedos, with an index.html report, into the run directory.
@@ -539,9 +544,10 @@ fn main() -> ExitCode {
             run(RunArgs { config, paths, seed, threads, out, shard, resume, checkpoint_seconds })
         }
         Command::Merge { shards, out } => merge(&shards, &out),
-        Command::Compare { run_dir, models, paths, threads, level, fail_on_reject } => {
+        Command::Compare { run_dir, models, paths, threads, level, fail_on_reject, external } => {
             let options = smithwalk::analysis::compare::CompareOptions {
                 family_level: level,
+                external,
                 ..smithwalk::analysis::compare::CompareOptions::new(models, paths, threads)
             };
             match smithwalk::analysis::compare::compare_with(&run_dir, &options) {

@@ -18,13 +18,15 @@
 
 use std::fmt::Write as _;
 use std::io::IsTerminal as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use microsurface::wang::Shadowing;
 
+use crate::analysis::compensation::{AlbedoCache, Compensation, compensated_bins};
+use crate::analysis::external::ExternalModel;
 use crate::analysis::models::{
     HammonFitPart, LobeIntegrals, MAX_BIN_EVALUATIONS, MAX_EXIT_BIN_EVALUATIONS, hammon_fit_lobe_bins,
     single_scattering_lobe,
@@ -62,11 +64,13 @@ pub struct CompareOptions {
     pub threads: Option<usize>,
     /// The family-wise level of each model's verdict (Sidak over its lobes).
     pub family_level: f64,
+    /// A user's own model in the run's bins (`--external`), judged as [`Model::External`].
+    pub external: Option<PathBuf>,
 }
 
 impl CompareOptions {
     pub fn new(models: Vec<Model>, paths: Option<u64>, threads: Option<usize>) -> Self {
-        Self { models, paths, threads, family_level: DEFAULT_FAMILY_LEVEL }
+        Self { models, paths, threads, family_level: DEFAULT_FAMILY_LEVEL, external: None }
     }
 
     fn validate(&self) -> Result<()> {
@@ -94,7 +98,7 @@ pub fn is_exact_oracle(model: Model) -> bool {
 /// Whether a model is estimated by a Monte Carlo walk (with its own standard errors), not
 /// integrated in closed form.
 fn is_monte_carlo(model: Model) -> bool {
-    !matches!(model, Model::Single | Model::HammonFit)
+    matches!(model, Model::HeitzNee | Model::ExactPositionFree | Model::WangCorrelated | Model::WangUncorrelated)
 }
 
 /// One model's verdict on a run.
@@ -345,6 +349,73 @@ fn joint_chains(
     Ok(out)
 }
 
+/// The compensation models' lobes (`analysis::compensation`): the all-orders reflection slot 0
+/// of every case they apply to, per channel, each bin integrated to a tolerance tied to the
+/// smallest standard error of the measured bin over the channels.
+fn compensation(model: Model, run: &RunDir, measured: &Lobes, progress: &ProgressBar) -> Predictions {
+    let Some(compensation) = Compensation::of(model) else { return Predictions::default() };
+    let photons = run.config.paths as f64;
+    let channels = if run.config.is_rgb() { 3 } else { 1 };
+    let empty: Vec<BinValue> = vec![BinValue::default(); run.grid.bins()];
+    let mut cache = AlbedoCache::default();
+    let mut out = Predictions::default();
+    progress.set_length(run.cases.len() as u64);
+    for case in &run.cases {
+        let tolerances: Vec<f64> = (0..run.grid.bins())
+            .map(|bin| {
+                let se = (0..channels)
+                    .map(|c| measured.get(case.index, 0, "R", c).unwrap_or(&empty)[bin].energy_stderr)
+                    .fold(f64::INFINITY, f64::min);
+                QUADRATURE_FRACTION * se.max(1.0 / photons)
+            })
+            .collect();
+        let tolerance = |bin: usize| tolerances[bin];
+        let lobes: Vec<LobeIntegrals> = if channels == 3 {
+            compensated_bins::<3>(compensation, case, &run.grid, &tolerance, &mut cache).map(Vec::from)
+        } else {
+            compensated_bins::<1>(compensation, case, &run.grid, &tolerance, &mut cache).map(Vec::from)
+        }
+        .unwrap_or_default();
+        for (channel, integrals) in lobes.into_iter().enumerate() {
+            out.capped += integrals.capped;
+            if integrals.capped > 0 {
+                for (error, tol) in integrals.error.iter().zip(&tolerances) {
+                    out.worst_capped = out.worst_capped.max(error / tol);
+                }
+            }
+            let stderr = vec![0.0; run.grid.bins()];
+            let energy = integrals.energy;
+            out.lobes.push(ModelLobe {
+                case: case.index,
+                order: 0,
+                hemisphere: Hemisphere::R,
+                channel,
+                energy,
+                stderr,
+            });
+        }
+        progress.inc(1);
+    }
+    out
+}
+
+/// The lobes of a user's model (`--external`), as read and validated against the run.
+fn external_lobes(external: Option<&ExternalModel>) -> Predictions {
+    let lobes = external.map_or(&[][..], |e| &e.lobes[..]);
+    let lobes = lobes
+        .iter()
+        .map(|l| ModelLobe {
+            case: l.case,
+            order: l.order,
+            hemisphere: l.hemisphere,
+            channel: channel_index(Some(&l.channel)),
+            energy: l.energy.clone(),
+            stderr: l.stderr.clone(),
+        })
+        .collect();
+    Predictions { lobes, ..Predictions::default() }
+}
+
 /// Calls `f` for every lobe (case, order, hemisphere, channel) of a simulation.
 fn for_each_lobe(sim: &Simulation, f: &mut dyn FnMut(&Case, ModelLobe)) {
     fn visit<const C: usize>(case: &Case, d: &Detector<C>, f: &mut dyn FnMut(&Case, ModelLobe)) {
@@ -455,6 +526,8 @@ pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Op
 pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome> {
     options.validate()?;
     let run = RunDir::open(run_dir)?;
+    let external = options.external.as_deref().map(|path| crate::analysis::external::read(path, &run)).transpose()?;
+    let models = [&options.models[..], if external.is_some() { &[Model::External][..] } else { &[] }].concat();
     let measured = run.measured()?;
     let summary = run.summary()?;
     let measured_photons = run.config.paths;
@@ -482,10 +555,10 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
     let mut skipped: Vec<(Model, String)> = Vec::new();
     let empty: Vec<BinValue> = vec![BinValue::default(); run.grid.bins()];
     let mut joint: Option<Vec<(Model, Predictions)>> = None;
-    for (k, &model) in options.models.iter().enumerate() {
+    for (k, &model) in models.iter().enumerate() {
         let (start, cpu_start) = (Instant::now(), cpu_seconds());
         if terminal {
-            eprintln!("compare: {} ({}/{})", model.name(), k + 1, options.models.len());
+            eprintln!("compare: {} ({}/{})", model.name(), k + 1, models.len());
         }
         let seed = model_seed(config.seed, model.name());
         let predictions = match model {
@@ -495,9 +568,16 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
                 bar.finish_and_clear();
                 p
             }
+            Model::KullaConty | Model::Turquin | Model::FdezAguera => {
+                let bar = model_progress(model, terminal);
+                let p = compensation(model, &run, &measured, &bar);
+                bar.finish_and_clear();
+                p
+            }
+            Model::External => external_lobes(external.as_ref()),
             _ => {
                 if chain_model(model).is_some() && joint.is_none() {
-                    joint = Some(joint_chains(&options.models, &config, options.threads, terminal)?);
+                    joint = Some(joint_chains(&models, &config, options.threads, terminal)?);
                 }
                 match joint.as_mut().and_then(|j| j.iter().position(|(m, _)| *m == model).map(|i| j.swap_remove(i).1)) {
                     Some(p) => p,
@@ -520,7 +600,11 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
                 ),
             ));
         }
-        let model_photons = if is_monte_carlo(model) { config.paths } else { 0 };
+        let model_photons = match model {
+            Model::External => external.as_ref().map_or(0, ExternalModel::photons),
+            _ if is_monte_carlo(model) => config.paths,
+            _ => 0,
+        };
         for lobe in &predictions.lobes {
             let h = hemisphere_name(lobe.hemisphere);
             let id: LobeId = (lobe.case, lobe.order, h.clone(), lobe.channel);
@@ -548,8 +632,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
             cpu_seconds() - cpu_start
         );
     }
-    let verdicts: Vec<Verdict> = options
-        .models
+    let verdicts: Vec<Verdict> = models
         .iter()
         .map(|&model| {
             let mine: Vec<&LobeComparison> = comparisons.iter().filter(|c| c.model == model).collect();

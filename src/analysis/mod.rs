@@ -2,6 +2,8 @@
 //! of a run with them ([`compare`]), and the quadrature and statistics they rest on.
 
 pub mod compare;
+pub mod compensation;
+pub mod external;
 pub mod models;
 pub mod quadrature;
 pub mod stats;

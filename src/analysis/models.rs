@@ -214,7 +214,7 @@ fn bins_for<N: Ndf>(
 /// alpha, which is `2 alpha sin theta_o + 2 alpha^2` in `|cos theta|`; a tilt across it turns
 /// the reflected direction by `2 alpha cos theta_i` sideways, `2 alpha cos theta_i / sin
 /// theta_o` in phi, which is tiny at grazing incidence. The scales are taken a little smaller.
-fn specular_peak(case: &Case, hemisphere: Hemisphere, eta: f64) -> Option<Peak> {
+pub(crate) fn specular_peak(case: &Case, hemisphere: Hemisphere, eta: f64) -> Option<Peak> {
     let sin_i = case.theta_i_deg.to_radians().sin();
     let sin_o = match hemisphere {
         Hemisphere::R => sin_i,
@@ -234,7 +234,7 @@ fn specular_peak(case: &Case, hemisphere: Hemisphere, eta: f64) -> Option<Peak> 
 /// Integrates a cosine-weighted lobe `wo -> f(wi, wo) |cos theta_o|` over every bin of
 /// `hemisphere` (index `cos * phi_bins + phi`; phi from the incident azimuth), each to its
 /// `tolerance(bin)` within `bound` evaluations, graded towards `peak` where it lies.
-fn integrate_bins(
+pub(crate) fn integrate_bins(
     case: &Case,
     grid: &Grid,
     hemisphere: Hemisphere,

@@ -456,16 +456,27 @@ pub enum Model {
     WangCorrelated,
     WangUncorrelated,
     ExactPositionFree,
+    /// Energy compensation of Kulla & Conty 2017, all orders (`analysis::compensation`).
+    KullaConty,
+    /// Energy compensation of Turquin 2019, all orders.
+    Turquin,
+    /// Energy compensation of Fdez-Agüera 2019, all orders.
+    FdezAguera,
+    /// A user's own model read from a file (`smithwalk compare --external`); not in [`Model::ALL`].
+    External,
 }
 
 impl Model {
-    pub const ALL: [Model; 6] = [
+    pub const ALL: [Model; 9] = [
         Model::Single,
         Model::HammonFit,
         Model::HeitzNee,
         Model::WangCorrelated,
         Model::WangUncorrelated,
         Model::ExactPositionFree,
+        Model::KullaConty,
+        Model::Turquin,
+        Model::FdezAguera,
     ];
 
     pub fn name(self) -> &'static str {
@@ -476,6 +487,10 @@ impl Model {
             Model::WangCorrelated => "wang-correlated",
             Model::WangUncorrelated => "wang-uncorrelated",
             Model::ExactPositionFree => "exact-position-free",
+            Model::KullaConty => "kulla-conty",
+            Model::Turquin => "turquin",
+            Model::FdezAguera => "fdez-aguera",
+            Model::External => "external",
         }
     }
 
@@ -492,7 +507,7 @@ impl Model {
 #[serde(deny_unknown_fields)]
 pub struct CompareConfig {
     /// Model names: `single`, `hammon-fit`, `heitz-nee`, `exact-position-free`, `wang-correlated`,
-    /// `wang-uncorrelated`.
+    /// `wang-uncorrelated`, `kulla-conty`, `turquin`, `fdez-aguera`.
     pub models: Vec<String>,
     /// Photons per case for the Monte Carlo models (default: the run's `paths`).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -70,6 +70,10 @@ const VERMILLION: RGBColor = RGBColor(0xd5, 0x5e, 0x00);
 const PURPLE: RGBColor = RGBColor(0xcc, 0x79, 0xa7);
 const WINE: RGBColor = RGBColor(0x88, 0x22, 0x55);
 const GREY: RGBColor = RGBColor(0x77, 0x77, 0x77);
+const SKY: RGBColor = RGBColor(0x56, 0xb4, 0xe9);
+const OCHRE: RGBColor = RGBColor(0xb0, 0x8c, 0x00);
+const TEAL: RGBColor = RGBColor(0x33, 0x66, 0x66);
+const BROWN: RGBColor = RGBColor(0x8c, 0x51, 0x0a);
 
 const fn line(colour: RGBColor, dash: Dash) -> LineStyle {
     LineStyle { colour, dash, width: 2, marker: Marker::None }
@@ -84,6 +88,10 @@ pub fn model_style(model: Model) -> LineStyle {
         Model::ExactPositionFree => line(VERMILLION, Dash::LongDash),
         Model::WangCorrelated => line(ORANGE, Dash::Solid),
         Model::WangUncorrelated => line(PURPLE, Dash::Dotted),
+        Model::KullaConty => line(SKY, Dash::Solid),
+        Model::Turquin => line(OCHRE, Dash::Dashed),
+        Model::FdezAguera => line(TEAL, Dash::Dotted),
+        Model::External => line(BROWN, Dash::LongDash),
     }
 }
 
