@@ -15,8 +15,9 @@ model's cells are empty where it gives no lobe (docs/compare.md).
     python3 scripts/plot_lobes.py out/quickstart/lobes.csv --out lobes.png [--orders 1 2 3 0]
 
 With several surfaces, materials or hemispheres, one file each: lobes_g0_R.png, lobes_g1_T.png...
-(the --out name with _g<k>_<R|T> before the extension). An --out ending in .svg or .pdf writes
-vector files.
+(the --out name with _g<k>_<R|T> before the extension), numbered as `smithwalk plot` numbers
+its lobes_g<k>_<R|T>, so files of the same name show the same cases. The --out directory is
+created if need be. An --out ending in .svg or .pdf writes vector files.
 """
 import argparse
 import math
@@ -98,12 +99,18 @@ def main():
             folded = int(summary[summary.folded].order.max())
     orders = args.orders or sorted(df.order.unique(), key=lambda o: (o == 0, o))
     stem, ext = os.path.splitext(args.out)
+    # Numbered as `smithwalk plot` numbers lobes_g<k>_<R|T>: k counts the surfaces and
+    # materials (cases that differ only in theta_i) in order of their first case, and both
+    # hemispheres of one surface share its k.
     groups = [
-        (key, hemisphere, part)
-        for key, surface in df.groupby(SURFACE, sort=False)
+        (g, key, hemisphere, part)
+        for g, (key, surface) in enumerate(df.groupby(SURFACE, sort=False))
         for hemisphere, part in surface.groupby("hemisphere", sort=True)
     ]
-    for g, (key, hemisphere, surface) in enumerate(groups):
+    out_dir = os.path.dirname(args.out)
+    if out_dir:
+        os.makedirs(out_dir, exist_ok=True)
+    for g, key, hemisphere, surface in groups:
         label = dict(zip(SURFACE, key))
         thetas = sorted(surface.theta_i_deg.unique())
         fig, axes = plt.subplots(

@@ -301,12 +301,12 @@ fn run(args: RunArgs) -> Result<()> {
         let written = write_shard(&sim, &config, shard, &out)?;
         checkpoints.finish()?;
         println!(
-            "shard {}/{} of {} cases in {:.2} s on {} threads: wrote {}",
+            "shard {}/{} of {} cases in {:.2} s on {}: wrote {}",
             shard.index,
             shard.count,
             sim.cases.len(),
             sim.wall_seconds,
-            sim.threads,
+            threads_text(sim.threads),
             written.display()
         );
         return Ok(());
@@ -468,6 +468,11 @@ fn report(sim: &Simulation, config: &Config, written: &[PathBuf]) -> Result<()> 
     Ok(())
 }
 
+/// "1 thread", "2 threads".
+fn threads_text(threads: usize) -> String {
+    format!("{threads} thread{}", if threads == 1 { "" } else { "s" })
+}
+
 /// The end summary: throughput, then each case's energy balance with a legend of its columns.
 fn print_summary(sim: &Simulation, config: &Config, written: &[PathBuf]) -> std::io::Result<()> {
     let mut out = std::io::stdout().lock();
@@ -475,11 +480,11 @@ fn print_summary(sim: &Simulation, config: &Config, written: &[PathBuf]) -> std:
     let rate = total / sim.wall_seconds;
     writeln!(
         out,
-        "{} cases x {} paths in {:.2} s on {} threads: {rate:.3e} paths/s ({:.3e} per thread)",
+        "{} cases x {} paths in {:.2} s on {}: {rate:.3e} paths/s ({:.3e} per thread)",
         sim.cases.len(),
         config.paths,
         sim.wall_seconds,
-        sim.threads,
+        threads_text(sim.threads),
         rate / sim.threads as f64
     )?;
     write!(out, "{}{}", output::BALANCE_LEGEND, output::balance_table(sim))?;

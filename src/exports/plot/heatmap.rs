@@ -255,7 +255,7 @@ impl HeatFigure<'_> {
         format!(
             "Case {} ({}, θ_i = {:.1}°), {hemisphere}: the BSDF f (1/sr) per bounce order over the projected hemisphere, \
              x = sin θ_o cos φ_o, y = sin θ_o sin φ_o with φ_o from the incident azimuth (the light comes from +x{mirror}). \
-             Each pixel shows the detector bin its direction falls in, on {scale}.{}",
+             Each pixel is interpolated between the centres of the detector bins around its direction (linearly in |cos θ_o| and φ_o; at the pole, the mean of the innermost ring), on {scale}.{}",
             self.case.index,
             surface_label(self.case),
             self.case.theta_i_deg,
