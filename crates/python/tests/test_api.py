@@ -291,7 +291,7 @@ def test_plot_lobes_draws_the_models_of_models_csv(tmp_path):
         text=True,
     )
     assert done.returncode == 0, done.stderr
-    for name in ("l_g0_R.png", "l_g2_T.png"):
+    for name in ("l_g0_R.png", "l_g1_T.png"):
         assert f"{name} with heitz-nee, single" in done.stderr, done.stderr
         assert (tmp_path / name).exists()
     # A models.csv that is not beside this lobes.csv row for row is refused.
