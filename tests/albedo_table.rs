@@ -193,17 +193,20 @@ fn malformed_tables_are_refused_and_nothing_is_written() {
         .collect();
     let avg = "quantity,side,hemisphere,order,eta,alpha,E_avg,E_avg_stderr\nR_1,outside,R,1,,0.25,0.9,0\n\
                R_1,outside,R,1,,0.75,0.6,0\n";
+    let compare = |table: &std::path::Path, models: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_smithwalk"))
+            .args(["compare", run.to_str().unwrap(), "--models", models, "--albedo-table"])
+            .arg(table)
+            .output()
+            .unwrap()
+    };
     let refused = |lut: &str, avg: Option<&str>, expected: &[&str]| {
         let table = tempfile::tempdir().unwrap();
         std::fs::write(table.path().join("lut.csv"), format!("{head}{lut}")).unwrap();
         if let Some(avg) = avg {
             std::fs::write(table.path().join("lut_avg.csv"), avg).unwrap();
         }
-        let output = std::process::Command::new(env!("CARGO_BIN_EXE_smithwalk"))
-            .args(["compare", run.to_str().unwrap(), "--models", "kulla-conty", "--albedo-table"])
-            .arg(table.path())
-            .output()
-            .unwrap();
+        let output = compare(table.path(), "kulla-conty");
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert_eq!(output.status.code(), Some(1), "{stderr}");
         assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
@@ -223,4 +226,12 @@ fn malformed_tables_are_refused_and_nothing_is_written() {
     refused(&good, None, &["lut_avg.csv"]);
     refused(&good, Some(&avg.replace("0.6", "inf")), &["lut_avg.csv, line 3, column `E_avg`"]);
     refused(&good.replace(",0.25,", ",-1,"), Some(avg), &["column `alpha`", "alpha >= 0"]);
+    // A table no model reads is refused too.
+    let table = tempfile::tempdir().unwrap();
+    std::fs::write(table.path().join("lut.csv"), format!("{head}{good}")).unwrap();
+    std::fs::write(table.path().join("lut_avg.csv"), avg).unwrap();
+    let output = compare(table.path(), "single");
+    assert_eq!(output.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&output.stderr).contains("only read by the models kulla-conty"));
+    assert!(!run.join("models.csv").exists(), "something was written");
 }
