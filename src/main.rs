@@ -101,6 +101,12 @@ enum Command {
         /// [energy_stderr]; docs/compensation.md).
         #[arg(long)]
         external: Option<PathBuf>,
+        /// Evaluate kulla-conty, turquin and fdez-aguera from this table of E(mu, alpha) and
+        /// E_avg(alpha) with F = 1 instead of exact quadrature: a `smithwalk lut` conductor
+        /// directory, or its lut.csv (quantity R_1; E_avg from lut_avg.csv beside it), bilinear,
+        /// clamped at the table's edges (docs/compensation.md).
+        #[arg(long, value_name = "DIR_OR_FILE")]
+        albedo_table: Option<PathBuf>,
     },
     /// Draw a run's lobes (plane of incidence per order with the models of models.csv, polar
     /// heat maps) and per-order albedos, with an index.html report, into the run directory.
@@ -549,10 +555,11 @@ fn main() -> ExitCode {
             run(RunArgs { config, paths, seed, threads, out, shard, resume, checkpoint_seconds })
         }
         Command::Merge { shards, out } => merge(&shards, &out),
-        Command::Compare { run_dir, models, paths, threads, level, fail_on_reject, external } => {
+        Command::Compare { run_dir, models, paths, threads, level, fail_on_reject, external, albedo_table } => {
             let options = smithwalk::analysis::compare::CompareOptions {
                 family_level: level,
                 external,
+                albedo_table,
                 ..smithwalk::analysis::compare::CompareOptions::new(models, paths, threads)
             };
             match smithwalk::analysis::compare::compare_with(&run_dir, &options) {

@@ -25,6 +25,7 @@ use anyhow::{Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use microsurface::wang::Shadowing;
 
+use crate::analysis::albedo_table::AlbedoTable;
 use crate::analysis::compensation::{AlbedoCache, Compensation, compensated_bins};
 use crate::analysis::external::ExternalModel;
 use crate::analysis::models::{
@@ -66,11 +67,14 @@ pub struct CompareOptions {
     pub family_level: f64,
     /// A user's own model in the run's bins (`--external`), judged as [`Model::External`].
     pub external: Option<PathBuf>,
+    /// A table of `E` and `E_avg` with F = 1 that the compensation models read in place of the
+    /// exact functions (`--albedo-table`, [`AlbedoTable`]).
+    pub albedo_table: Option<PathBuf>,
 }
 
 impl CompareOptions {
     pub fn new(models: Vec<Model>, paths: Option<u64>, threads: Option<usize>) -> Self {
-        Self { models, paths, threads, family_level: DEFAULT_FAMILY_LEVEL, external: None }
+        Self { models, paths, threads, family_level: DEFAULT_FAMILY_LEVEL, external: None, albedo_table: None }
     }
 
     fn validate(&self) -> Result<()> {
@@ -352,12 +356,18 @@ fn joint_chains(
 /// The compensation models' lobes (`analysis::compensation`): the all-orders reflection slot 0
 /// of every case they apply to, per channel, each bin integrated to a tolerance tied to the
 /// smallest standard error of the measured bin over the channels.
-fn compensation(model: Model, run: &RunDir, measured: &Lobes, progress: &ProgressBar) -> Predictions {
+fn compensation(
+    model: Model,
+    run: &RunDir,
+    measured: &Lobes,
+    table: Option<&AlbedoTable>,
+    progress: &ProgressBar,
+) -> Predictions {
     let Some(compensation) = Compensation::of(model) else { return Predictions::default() };
     let photons = run.config.paths as f64;
     let channels = if run.config.is_rgb() { 3 } else { 1 };
     let empty: Vec<BinValue> = vec![BinValue::default(); run.grid.bins()];
-    let mut cache = AlbedoCache::default();
+    let mut cache = table.cloned().map_or_else(AlbedoCache::default, AlbedoCache::with_table);
     let mut out = Predictions::default();
     progress.set_length(run.cases.len() as u64);
     for case in &run.cases {
@@ -528,6 +538,12 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
     let run = RunDir::open(run_dir)?;
     let external = options.external.as_deref().map(|path| crate::analysis::external::read(path, &run)).transpose()?;
     let models = [&options.models[..], if external.is_some() { &[Model::External][..] } else { &[] }].concat();
+    let albedo_table = options.albedo_table.as_deref().map(AlbedoTable::read).transpose()?;
+    if albedo_table.is_some() && !models.iter().any(|&m| Compensation::of(m).is_some()) {
+        bail!(
+            "`--albedo-table` is only read by the models kulla-conty, turquin and fdez-aguera; add one to `--models`"
+        );
+    }
     let measured = run.measured()?;
     let summary = run.summary()?;
     let measured_photons = run.config.paths;
@@ -570,8 +586,11 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
             }
             Model::KullaConty | Model::Turquin | Model::FdezAguera => {
                 let bar = model_progress(model, terminal);
-                let p = compensation(model, &run, &measured, &bar);
+                let p = compensation(model, &run, &measured, albedo_table.as_ref(), &bar);
                 bar.finish_and_clear();
+                if let Some(table) = &albedo_table {
+                    notes.push((model, table.describe()));
+                }
                 p
             }
             Model::External => external_lobes(external.as_ref()),

@@ -16,7 +16,9 @@
 //! camera ray arrives from: smithwalk's outgoing direction `wo` (towards the detector), not the
 //! light's `wi`. `E(mu)` is the directional albedo of single scattering with F = 1 and
 //! `E_F(mu)` the one with the facet's Fresnel (docs/theory.md §9.4), both from quadrature of the exact
-//! single-scattering lobe (§5), not from a noisy table: each model is exactly itself.
+//! single-scattering lobe (§5), not from a noisy table: each model is exactly itself. On request
+//! (`--albedo-table`, [`AlbedoTable`]) `E` and `E_avg` come from a user's table instead, as
+//! engines ship them.
 
 use std::f64::consts::PI;
 
@@ -25,6 +27,7 @@ use microsurface::fresnel;
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, slope_to_normal};
 use microsurface::single;
 
+use crate::analysis::albedo_table::{AlbedoTable, linear};
 use crate::analysis::models::{LobeIntegrals, MAX_BIN_EVALUATIONS, integrate_bins, specular_peak};
 use crate::analysis::quadrature::{gauss_legendre, integrate};
 use crate::engine::detector::{Grid, Hemisphere};
@@ -317,11 +320,21 @@ impl Panel {
 /// between them; `average` is `E_avg = 2 ∫ E(mu) mu dmu`, the Gauss–Legendre sum of the same
 /// nodes (exact for the interpolant) plus the part below [`MU_MIN`]. The interpolant differs
 /// from direct quadrature by at most 1e-6 (GGX and Beckmann, alpha 0.01 to 3; measured in
-/// `tests/compensation.rs`: 7.7e-7 at Beckmann alpha 3, `mu = 1`).
+/// `tests/compensation.rs`: 7.7e-7 at Beckmann alpha 3, `mu = 1`). [`Albedo::linear`] is the
+/// other kind: a row of a user's table.
 #[derive(Clone, Debug)]
 pub struct Albedo {
-    panels: Vec<Panel>,
+    shape: Shape,
     average: f64,
+}
+
+/// How an [`Albedo`] is represented between its nodes.
+#[derive(Clone, Debug)]
+enum Shape {
+    /// Exact: polynomial on graded panels.
+    Panels(Vec<Panel>),
+    /// A user's table ([`AlbedoTable`]): linear between `mu` nodes, clamped outside them.
+    Linear { mu: Vec<f64>, e: Vec<f64> },
 }
 
 impl Albedo {
@@ -356,14 +369,26 @@ impl Albedo {
                     .iter()
                     .flat_map(|p| p.nodes.iter().zip(&p.values).map(|(&(mu, w), &e)| w * mu * e))
                     .sum::<f64>();
-        Albedo { panels, average }
+        Albedo { shape: Shape::Panels(panels), average }
     }
 
-    /// `E(mu)` for `mu` in `[0, 1]` (held at `E(MU_MIN)` below [`MU_MIN`], as
+    /// `E(mu)` given at increasing `mu` nodes (at least 2), linear between them and held at the
+    /// first and last node's value outside them, with its `average` given too (a row of an
+    /// [`AlbedoTable`]).
+    pub fn linear(mu: Vec<f64>, e: Vec<f64>, average: f64) -> Self {
+        Albedo { shape: Shape::Linear { mu, e }, average }
+    }
+
+    /// `E(mu)` for `mu` in `[0, 1]` (exact: held at `E(MU_MIN)` below [`MU_MIN`], as
     /// [`directional_albedo`] is).
     pub fn at(&self, mu: f64) -> f64 {
-        let mu = mu.max(MU_MIN);
-        self.panels.iter().find(|p| mu <= p.hi).unwrap_or(&self.panels[self.panels.len() - 1]).at(mu)
+        match &self.shape {
+            Shape::Panels(panels) => {
+                let mu = mu.max(MU_MIN);
+                panels.iter().find(|p| mu <= p.hi).unwrap_or(&panels[panels.len() - 1]).at(mu)
+            }
+            Shape::Linear { mu: nodes, e } => linear(nodes, e, mu),
+        }
     }
 
     /// `E_avg = 2 ∫_0^1 E(mu) mu dmu`.
@@ -438,17 +463,26 @@ impl<'a, N: Ndf> Compensated<'a, N> {
 #[derive(Default)]
 pub struct AlbedoCache {
     entries: Vec<((NdfKind, f64, Fresnel), Albedo)>,
+    /// A user's table of `E` and `E_avg` with F = 1 (`--albedo-table`), read in place of the
+    /// exact functions with F = 1 whatever the NDF; `E_F` with another Fresnel stays exact.
+    table: Option<AlbedoTable>,
 }
 
 impl AlbedoCache {
+    /// A cache that takes `E` and `E_avg` with F = 1 from `table` (see [`AlbedoTable`]).
+    pub fn with_table(table: AlbedoTable) -> Self {
+        AlbedoCache { entries: Vec::new(), table: Some(table) }
+    }
+
     pub fn get(&mut self, ndf: NdfKind, alpha: f64, f: Fresnel) -> &Albedo {
         let key = (ndf, alpha, f);
         let index = match self.entries.iter().position(|(k, _)| *k == key) {
             Some(i) => i,
             None => {
-                let albedo = match ndf {
-                    NdfKind::Ggx => Albedo::exact(&Ggx::with_alpha(alpha), f),
-                    NdfKind::Beckmann => Albedo::exact(&Beckmann::with_alpha(alpha), f),
+                let albedo = match (&self.table, ndf) {
+                    (Some(table), _) if f == Fresnel::One => table.albedo(alpha),
+                    (_, NdfKind::Ggx) => Albedo::exact(&Ggx::with_alpha(alpha), f),
+                    (_, NdfKind::Beckmann) => Albedo::exact(&Beckmann::with_alpha(alpha), f),
                 };
                 self.entries.push((key, albedo));
                 self.entries.len() - 1

@@ -1,6 +1,7 @@
 //! Measurements against models: the analytic bin expectations ([`models`]), the comparison
 //! of a run with them ([`compare`]), and the quadrature and statistics they rest on.
 
+pub mod albedo_table;
 pub mod compare;
 pub mod compensation;
 pub mod external;
