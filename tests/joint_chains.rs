@@ -70,11 +70,7 @@ fn each_channel_of_the_joint_chain_is_its_model_alone() {
             if transmits && *model == ChainModel::PositionFree {
                 continue;
             }
-            let estimator = match model {
-                ChainModel::Wang(s) => Estimator::Wang(*s),
-                ChainModel::PositionFree => Estimator::PositionFree,
-            };
-            let alone = common::simulate_with(&toml(body, 20 + 3 * i as u64 + c as u64), estimator);
+            let alone = common::simulate_with(&toml(body, 20 + 3 * i as u64 + c as u64), model.estimator());
             let alone = common::mono(&alone, 0);
             let hemispheres: &[Hemisphere] = if transmits { &[Hemisphere::R, Hemisphere::T] } else { &[Hemisphere::R] };
             for &h in hemispheres {

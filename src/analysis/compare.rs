@@ -274,22 +274,34 @@ fn monte_carlo(
     threads: Option<usize>,
     progress: bool,
 ) -> Result<Predictions> {
-    let estimator = match model {
-        Model::WangCorrelated => Estimator::Wang(Shadowing::Correlated),
-        Model::WangUncorrelated => Estimator::Wang(Shadowing::Uncorrelated),
-        Model::ExactPositionFree => Estimator::PositionFree,
-        _ => Estimator::HeitzNee(NEE_DIRECTIONS),
-    };
-    let model_config = Config { seed, ..config.clone() };
-    let options = RunOptions { estimator, shard: Shard::WHOLE, threads, show_progress: progress };
-    let sim = crate::engine::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))?;
+    let estimator = chain_model(model).map_or(Estimator::HeitzNee(NEE_DIRECTIONS), ChainModel::estimator);
+    let sim = simulate_model(config, seed, estimator, threads, progress)?;
     let mut out = Predictions::default();
     for_each_lobe(&sim, &mut |case, lobe| {
-        if model != Model::ExactPositionFree || case.position_free_applies() {
+        if describes(model, case) {
             out.lobes.push(lobe);
         }
     });
     Ok(out)
+}
+
+/// A Monte Carlo model's simulation: `estimator` walked with the run's config and `seed`.
+fn simulate_model(
+    config: &Config,
+    seed: u64,
+    estimator: Estimator,
+    threads: Option<usize>,
+    progress: bool,
+) -> Result<Simulation> {
+    let model_config = Config { seed, ..config.clone() };
+    let options = RunOptions { estimator, shard: Shard::WHOLE, threads, show_progress: progress };
+    crate::engine::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))
+}
+
+/// Whether a Monte Carlo model describes `case`: the exact position-free chain only one-sided
+/// facets ([`Case::position_free_applies`]), the others every case.
+fn describes(model: Model, case: &Case) -> bool {
+    model != Model::ExactPositionFree || case.position_free_applies()
 }
 
 /// The seed of a Monte Carlo model's streams: the run's seed mixed with the model's name (FNV-1a),
@@ -313,9 +325,9 @@ fn chain_model(model: Model) -> Option<ChainModel> {
 /// in channel `c`, [`Estimator::JointChains`]) when all three are asked for and the run is
 /// mono; empty otherwise (each is then walked alone). Two models would pay for the third
 /// channel of the RGB detector and gain nothing: measured on the quickstart, the three take
-/// 6.6 s together against 9.1 s alone, two about as long together as alone. Each model's estimator is the one it
-/// has alone but for the random numbers, and Russian roulette plays on the largest of the
-/// weights, so no model is noisier than alone.
+/// 6.6 s together against 9.1 s alone, two about as long together as alone. Each model's
+/// estimator is the one it has alone but for the random numbers, and Russian roulette plays on
+/// the largest of the weights, so no model is noisier than alone.
 fn joint_chains(
     models: &[Model],
     config: &Config,
@@ -333,14 +345,11 @@ fn joint_chains(
     let seed = model_seed(config.seed, &names.join(","));
     let (start, cpu_start) = (Instant::now(), cpu_seconds());
     let kinds = std::array::from_fn(|c| chained[c].1);
-    let model_config = Config { seed, ..config.clone() };
-    let options =
-        RunOptions { estimator: Estimator::JointChains(kinds), shard: Shard::WHOLE, threads, show_progress: progress };
-    let sim = crate::engine::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))?;
+    let sim = simulate_model(config, seed, Estimator::JointChains(kinds), threads, progress)?;
     let mut out: Vec<(Model, Predictions)> = chained.iter().map(|&(m, _)| (m, Predictions::default())).collect();
     for_each_lobe(&sim, &mut |case, lobe| {
         if let Some((model, predictions)) = out.get_mut(lobe.channel)
-            && (*model != Model::ExactPositionFree || case.position_free_applies())
+            && describes(*model, case)
         {
             predictions.lobes.push(ModelLobe { channel: 0, ..lobe });
         }

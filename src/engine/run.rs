@@ -78,6 +78,16 @@ pub enum ChainModel {
     PositionFree,
 }
 
+impl ChainModel {
+    /// The estimator that walks this model alone.
+    pub fn estimator(self) -> Estimator {
+        match self {
+            ChainModel::Wang(s) => Estimator::Wang(s),
+            ChainModel::PositionFree => Estimator::PositionFree,
+        }
+    }
+}
+
 /// The visibility of a [`ChainModel`] for one photon.
 #[derive(Clone, Debug)]
 enum ChainVisibility {
