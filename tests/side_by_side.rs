@@ -58,7 +58,8 @@ fn both_walks<N: Ndf, F: Facet<1>>(surface: &Microsurface<N>, facet: &F, wi: DVe
     }
     let mut side_by_side = Detector::new(GRID, wi, Some(6));
     surface.walk_side_by_side(facet, &POLICY, wi, PHOTONS, &mut chunk_rng(seed, 1, 0), &mut side_by_side);
-    // Photons of unit weight reach the bins' tallies when the detector settles.
+    // A detector's sums (and photons of unit weight) reach its tallies when it settles.
+    plain.settle();
     side_by_side.settle();
     [plain, side_by_side]
 }

@@ -345,6 +345,7 @@ where
         // output's identity, like CHUNK: the two draw random numbers in different orders.
         if w.settings.estimator == Estimator::Walk && policy.never_splits(&w.facet) {
             w.surface.walk_side_by_side(&w.facet, policy, wi, photons, &mut rng, detector);
+            detector.end_chunk();
             return;
         }
         let mut stack = Vec::new();
@@ -378,6 +379,7 @@ where
             };
             detector.end_photon(interactions);
         }
+        detector.end_chunk();
     }
 }
 
