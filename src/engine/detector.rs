@@ -434,7 +434,7 @@ pub struct Detector<const C: usize> {
     incident_side: Side,
     max_order: Option<u32>,
     pub tallies: Tallies<C>,
-    /// The photon in flight's escaped and lost weight so far.
+    /// The photon in flight's escaped weight so far, and its lost weight per [`Loss`] reason.
     escaped: [f64; C],
     pending_loss: [[f64; C]; 3],
     any_loss: bool,
@@ -461,8 +461,9 @@ pub struct Detector<const C: usize> {
 /// by a photon stay in cache more often, and a deposit converts nothing.
 #[derive(Clone, Copy, Debug)]
 struct ChunkBin<const C: usize> {
-    /// The current photon's deposits in the bin so far (split photons only), summed before
-    /// squaring, so variances stay per photon (§4.6).
+    /// The photon in flight's deposits in the bin so far ([`Observer::escape`]; a photon that
+    /// was split escapes several times), summed before squaring, so variances stay per photon
+    /// (§4.6).
     photon: [f64; C],
     sum: [f64; C],
     sum_sq: [f64; C],
