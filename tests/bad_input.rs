@@ -31,7 +31,23 @@ fn every_bad_config_names_its_field_value_and_what_is_allowed() {
         (with("alpha = 0.5", "alpha = 0.5\nnormals = \"foo\""), ["`surface.normals` = \"foo\"", "`vndf`"]),
         (with("\"conductor\"", "\"conductor\"\ncolor = 3"), ["`material.color` is not a known key", "`fresnel`"]),
         (with("\"conductor\"", "\"dielectric\""), ["`material.eta` is missing", "missing field `eta`"]),
-        (with("\"conductor\"", "\"diffuse\"\nalbedo = [0.5, 0.5]"), ["`material`", "three values [r, g, b]"]),
+        // A value inside a material is named by its key and line, though serde reports it at
+        // the whole table (tagged by `kind`).
+        (
+            with("\"conductor\"", "\"diffuse\"\nalbedo = [0.5, 0.5]"),
+            ["`material.albedo` = [0.5, 0.5] is not allowed (line 6)", "three values [r, g, b]"],
+        ),
+        (
+            with("\"conductor\"", "\"dielectric\"\nname = \"glass\"\neta = [1.4, 1.5, 1.6]"),
+            ["`material.eta` = [1.4, 1.5, 1.6] is not allowed (line 7)", "dispersion, is not modelled"],
+        ),
+        (
+            with(
+                "[material]\nkind = \"conductor\"",
+                "[[material]]\nkind = \"conductor\"\n[[material]]\nkind = \"conductor\"\nfresnel = \"exact\"\neta = 0.2\nk = [3.9, 2.4]",
+            ),
+            ["`material[1].k` = [3.9, 2.4] is not allowed (line 10)", "three values [r, g, b]"],
+        ),
         (
             with("alpha = 0.5", "alpha = [[0.1, 0.2, 0.3]]"),
             ["`surface.alpha[0]` = [0.1, 0.2, 0.3]", "[alpha_x, alpha_y]"],

@@ -151,7 +151,8 @@ fn the_correlated_central_spike_is_the_models() {
     // docs/theory.md §6.6, "The correlated model's central spike": dielectric eta 1.5, GGX
     // alpha 0.5, theta_i 0.5 rad. Energy in the innermost ring |cos theta| in [31/32, 1] of the
     // transmitted orders 3 and 4+, from an independent numpy implementation of the
-    // supplement's formulas (4*10^6 chains, standard error from 10 batches): (slot,
+    // supplement's formulas, scripts/wang_chain_reference.py (4*10^6 chains, standard error
+    // from 10 batches; its docstring has the commands): (slot,
     // correlated, its SE, uncorrelated, its SE). 10^6 photons here; each of the four values
     // within 4 combined SE (two-sided 6e-5 each).
     let reference = [(3, 1.9177e-3, 7.6e-6, 3.610e-4, 5.1e-6), (4, 1.1286e-3, 2.3e-6, 9.71e-5, 2.0e-6)];

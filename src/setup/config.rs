@@ -238,6 +238,7 @@ pub enum MaterialConfig {
         name: Option<String>,
     },
     Dielectric {
+        #[serde(deserialize_with = "relative_index")]
         eta: f64,
         #[serde(default, skip_serializing_if = "Option::is_none")]
         name: Option<String>,
@@ -256,6 +257,27 @@ pub enum MaterialConfig {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         name: Option<String>,
     },
+}
+
+/// A dielectric's `eta`: one number, so that a list gets an error that says why.
+fn relative_index<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    struct Visitor;
+    impl serde::de::Visitor<'_> for Visitor {
+        type Value = f64;
+        fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+            f.write_str("one number, the relative index n_inside / n_outside of every channel (an index per channel, dispersion, is not modelled)")
+        }
+        fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<f64, E> {
+            Ok(v)
+        }
+        fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<f64, E> {
+            Ok(v as f64)
+        }
+        fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<f64, E> {
+            Ok(v as f64)
+        }
+    }
+    d.deserialize_any(Visitor)
 }
 
 fn fresnel_none() -> FresnelKind {
@@ -760,9 +782,61 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, Confi
                 parse(format!("`{}` is missing{line}: {allowed}", format!("{field}.{k}").trim_start_matches(".")))
             }
             _ if field == "." => parse(format!("{allowed}{line}")),
-            _ => parse(format!("`{field}` = {value} is not allowed{line}: {allowed}")),
+            _ => match material_culprit(text, &field, inner.message()) {
+                Some(Culprit { key, value, line }) => {
+                    let line = line.map_or(String::new(), |n| format!(" (line {n})"));
+                    parse(format!("`{field}.{key}` = {value} is not allowed{line}: {allowed}"))
+                }
+                None => parse(format!("`{field}` = {value} is not allowed{line}: {allowed}")),
+            },
         }
     })
+}
+
+/// The key of a material table whose value is wrong, its value and its line.
+struct Culprit {
+    key: String,
+    value: String,
+    line: Option<usize>,
+}
+
+/// Which key of the material at `field` (`material` or `material[i]`) causes the error
+/// `message`. Serde reports errors of values inside a material at the whole table, since the
+/// table is tagged by `kind` and read as a whole before its keys are; the culprit is the key
+/// whose removal makes the error go away or change. Its line is that of the key after the
+/// table's header (none for an inline table).
+fn material_culprit(text: &str, field: &str, message: &str) -> Option<Culprit> {
+    let document: toml::Table = toml::from_str(text).ok()?;
+    let index = match field.strip_prefix("material")? {
+        "" => None,
+        rest => Some(rest.strip_prefix('[')?.strip_suffix(']')?.parse::<usize>().ok()?),
+    };
+    let table = match (document.get("material")?, index) {
+        (toml::Value::Table(t), None) => t,
+        (toml::Value::Array(a), Some(i)) => a.get(i)?.as_table()?,
+        _ => return None,
+    };
+    let key = table.keys().filter(|k| *k != "kind").find(|k| {
+        let mut without = table.clone();
+        without.remove(k.as_str());
+        MaterialConfig::deserialize(toml::Value::Table(without)).map_or_else(|e| e.message() != message, |_| true)
+    })?;
+    let value = shorten(&table[key].to_string(), VALUE_CHARS);
+    // The key's line: the first `key =` after the header of the material's table.
+    let is_header = |l: &str| {
+        let l: String = l.chars().filter(|c| !c.is_whitespace()).collect();
+        l == "[material]" || l == "[[material]]"
+    };
+    let lines: Vec<&str> = text.lines().collect();
+    let header = lines.iter().enumerate().filter(|(_, l)| is_header(l)).nth(index.unwrap_or(0)).map(|(n, _)| n);
+    let line = header.and_then(|h| {
+        lines[h + 1..]
+            .iter()
+            .take_while(|l| !l.trim_start().starts_with('['))
+            .position(|l| l.split('=').next().is_some_and(|k| k.trim() == key))
+            .map(|n| h + 1 + n + 1)
+    });
+    Some(Culprit { key: key.clone(), value, line })
 }
 
 /// Longest quoted value and message in a config error.
