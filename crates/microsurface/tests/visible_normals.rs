@@ -20,9 +20,9 @@ use std::f64::consts::TAU;
 use microsurface::DVec3;
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, visible_slope_beckmann};
 use microsurface::normals::Normals;
+use numerics::quadrature::{integrate, integrate_2d};
+use numerics::stats::{WeightedBin, chi_square, sidak};
 use rand_pcg::Pcg64Mcg;
-use smithwalk::analysis::quadrature::{integrate, integrate_2d};
-use smithwalk::analysis::stats::{WeightedBin, chi_square, sidak};
 
 const SAMPLES: u64 = 200_000;
 const COS_BINS: usize = 16;
