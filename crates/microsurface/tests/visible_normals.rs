@@ -145,7 +145,7 @@ fn visible_normals_match_the_visible_normal_density() {
     }
 }
 
-const HAMMON_TESTS: usize = 4;
+const HAMMON_TESTS: usize = 5;
 
 /// The chi-square tests of this file at the family level 0.01: the cases of `all_cases` (2
 /// NDFs), Hammon's, the slope tests and the lanes.
@@ -155,6 +155,9 @@ const FAMILY: usize = 2 * ROUGHNESSES.len() * DIRECTIONS.len() + HAMMON_TESTS + 
 fn hammon_rejection_samples_the_unweighted_restricted_ndf() {
     let level = sidak(0.01, FAMILY);
     let cases = [
+        // Normal incidence: the travel direction has no azimuth, so the sampler's frame is
+        // its fallback.
+        ((0.5, 0.5), (0.0, 0.0)),
         ((0.5, 0.5), (40.0, 70.0)),
         ((0.5, 0.5), (120.0, 130.0)),
         ((0.8, 0.3), (60.0, 100.0)),
