@@ -238,7 +238,8 @@ fn beckmann_visible_slope_matches_its_density() {
 fn visible_normals_stay_unit_at_the_poles_and_the_horizon() {
     // §10: directions whose tangential part underflows the slope ratio (1e-310), the poles
     // themselves, and the horizon from both sides give unit upper-hemisphere normals that face
-    // the direction (at -z, where A = 0, the samplers return +z).
+    // the direction (at -z, where A = 0, the samplers return +z). Hammon's sampler too: a ray
+    // travelling straight up hits no facet (its rejection loop would never end) and gets +z.
     let tiny = 1e-310;
     let directions = [
         DVec3::Z,
@@ -256,6 +257,8 @@ fn visible_normals_stay_unit_at_the_poles_and_the_horizon() {
             let ms = [
                 Ggx(Roughness { x: 0.4, y: 0.9 }).sample_visible(w, &mut rng),
                 Beckmann(Roughness { x: 0.4, y: 0.9 }).sample_visible(w, &mut rng),
+                Normals::HammonRejection.sample(&Ggx(Roughness { x: 0.4, y: 0.9 }), -w, &mut rng),
+                Normals::HammonRejection.sample(&Beckmann(Roughness { x: 0.4, y: 0.9 }), -w, &mut rng),
             ];
             for m in ms {
                 assert!(m.is_finite() && (m.length() - 1.0).abs() < 1e-12 && m.z >= 0.0, "w {w}: normal {m}");
