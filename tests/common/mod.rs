@@ -5,8 +5,13 @@ use smithwalk::Simulation;
 use smithwalk::analysis::stats::WeightedBin;
 use smithwalk::engine::detector::{Detector, Hemisphere, OrderTallies};
 use smithwalk::engine::run::CaseResult;
-use smithwalk::microsurface::DVec3;
 use smithwalk::setup::config::Config;
+
+// `dir` and `two_sided_z`, shared with the physics crate's tests.
+#[path = "../../crates/microsurface/tests/common/mod.rs"]
+mod physics;
+#[allow(unused_imports)] // not every test file uses them
+pub use physics::{dir, two_sided_z};
 
 /// Both facet kinds (a conductor, and a dielectric that transmits) at two roughnesses and two
 /// incident angles on an 8 x 16 grid, seed 11, without `paths` and `max_order` (the tests add
@@ -107,13 +112,6 @@ pub fn albedo(d: &Detector<1>, slot: usize, hemisphere: Hemisphere) -> (f64, f64
         .map_or((0.0, 0.0), |t| t.albedo[hemisphere as usize].mean_and_stderr(d.tallies.photons, 0))
 }
 
-/// The unit direction at polar angle `theta_deg` and azimuth `phi_deg` (degrees).
-pub fn dir(theta_deg: f64, phi_deg: f64) -> DVec3 {
-    let (st, ct) = theta_deg.to_radians().sin_cos();
-    let (sp, cp) = phi_deg.to_radians().sin_cos();
-    DVec3::new(st * cp, st * sp, ct)
-}
-
 /// docs/theory.md §9.4: per-order albedos E1..E6 of the random walk, conductor F = 1, isotropic
 /// GGX, (alpha, theta_i deg); 2*10^6 photons, SE <= 4e-4, rounded to 4 decimals.
 pub const CONDUCTOR_ORDERS: [(f64, f64, [f64; 6]); 8] = [
@@ -175,9 +173,4 @@ pub fn assert_lobes_agree(
         let z = (x.0 - y.0) / (x.1 * x.1 + y.1 * y.1).sqrt();
         assert!(z.abs() < z_limit, "{label} order {k} {hemisphere:?}: {x:?} vs {y:?}, z = {z:.2}");
     }
-}
-
-/// The two-sided standard-normal quantile for a test at `level`: `|z|` beyond it rejects.
-pub fn two_sided_z(level: f64) -> f64 {
-    statrs::distribution::ContinuousCDF::inverse_cdf(&statrs::distribution::Normal::standard(), 1.0 - level / 2.0)
 }

@@ -10,6 +10,10 @@
 //! The Beckmann sampler's slope along the view direction is also tested on its own, at values
 //! of `mu = cot theta'` on both sides of each switch between its rejection proposals: 200 000
 //! slopes per `mu` on 40 bins, against bin integrals of its density by adaptive quadrature.
+//!
+//! The lane sampler of the side-by-side walk (`Normals::sample_lanes`, GGX's own on 4 lanes,
+//! Beckmann's and Hammon's on 2) is tested the same way, each lane with its own direction:
+//! 200 000 normals per lane against that direction's law.
 
 mod common;
 
@@ -20,9 +24,9 @@ use std::f64::consts::TAU;
 use microsurface::DVec3;
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, visible_slope_beckmann};
 use microsurface::normals::Normals;
+use numerics::quadrature::{integrate, integrate_2d};
+use numerics::stats::{WeightedBin, chi_square, sidak};
 use rand_pcg::Pcg64Mcg;
-use smithwalk::analysis::quadrature::{integrate, integrate_2d};
-use smithwalk::analysis::stats::{WeightedBin, chi_square, sidak};
 
 const SAMPLES: u64 = 200_000;
 const COS_BINS: usize = 16;
@@ -101,8 +105,10 @@ fn all_cases() -> Vec<NormalCase> {
     v
 }
 
-fn check<N: Ndf>(ndf: &N, normals: Normals, w: DVec3, level: f64, seed: u64, label: &str) {
-    let expect = match normals {
+/// The bin probabilities of the law `normals` draws for `w` (the visible normals, or §3.3's
+/// law of Hammon's sampler), by quadrature.
+fn law<N: Ndf>(ndf: &N, normals: Normals, w: DVec3) -> Vec<f64> {
+    match normals {
         Normals::Visible => expected(|m| ndf.d(m) * w.dot(m).max(0.0) / ndf.projected_area(w)),
         Normals::HammonRejection => {
             // §3.3: p_H(m) = D(m) m_z 1[w·m > 0] / N(w).
@@ -110,7 +116,11 @@ fn check<N: Ndf>(ndf: &N, normals: Normals, w: DVec3, level: f64, seed: u64, lab
             let norm: f64 = unnormalized.iter().sum();
             unnormalized.into_iter().map(|p| p / norm).collect()
         }
-    };
+    }
+}
+
+fn check<N: Ndf>(ndf: &N, normals: Normals, w: DVec3, level: f64, seed: u64, label: &str) {
+    let expect = law(ndf, normals, w);
     if normals == Normals::Visible {
         // §9.1: D_w integrates to 1 for every w (to the quadrature accuracy of the kink at w·m = 0).
         let total: f64 = expect.iter().sum();
@@ -123,7 +133,7 @@ fn check<N: Ndf>(ndf: &N, normals: Normals, w: DVec3, level: f64, seed: u64, lab
 #[test]
 fn visible_normals_match_the_visible_normal_density() {
     let cases = all_cases();
-    let level = sidak(0.01, cases.len() + HAMMON_TESTS + SLOPE_MUS.len());
+    let level = sidak(0.01, FAMILY);
     for (i, (ndf, (ax, ay), (t, p))) in cases.into_iter().enumerate() {
         let r = Roughness { x: ax, y: ay };
         let w = dir(t, p);
@@ -135,12 +145,19 @@ fn visible_normals_match_the_visible_normal_density() {
     }
 }
 
-const HAMMON_TESTS: usize = 4;
+const HAMMON_TESTS: usize = 5;
+
+/// The chi-square tests of this file at the family level 0.01: the cases of `all_cases` (2
+/// NDFs), Hammon's, the slope tests and the lanes.
+const FAMILY: usize = 2 * ROUGHNESSES.len() * DIRECTIONS.len() + HAMMON_TESTS + SLOPE_MUS.len() + LANE_TESTS;
 
 #[test]
 fn hammon_rejection_samples_the_unweighted_restricted_ndf() {
-    let level = sidak(0.01, all_cases().len() + HAMMON_TESTS + SLOPE_MUS.len());
+    let level = sidak(0.01, FAMILY);
     let cases = [
+        // Normal incidence: the travel direction has no azimuth, so the sampler's frame is
+        // its fallback.
+        ((0.5, 0.5), (0.0, 0.0)),
         ((0.5, 0.5), (40.0, 70.0)),
         ((0.5, 0.5), (120.0, 130.0)),
         ((0.8, 0.3), (60.0, 100.0)),
@@ -179,7 +196,7 @@ const SLOPE_MUS: [f64; 12] = [-3.0, -0.75, -0.7, -0.3, -1e-9, 0.0, 1e-9, 0.52, 1
 fn beckmann_visible_slope_matches_its_density() {
     const SLOPES: u64 = 200_000;
     const BINS: usize = 40;
-    let level = sidak(0.01, all_cases().len() + HAMMON_TESTS + SLOPE_MUS.len());
+    let level = sidak(0.01, FAMILY);
     for (i, mu) in SLOPE_MUS.into_iter().enumerate() {
         // §3.1 in the stretched frame: p(x) ∝ (mu - x) e^{-x^2} on x < mu. Bins cover where the
         // mass is; the cells below and above them take the rest.
@@ -221,7 +238,8 @@ fn beckmann_visible_slope_matches_its_density() {
 fn visible_normals_stay_unit_at_the_poles_and_the_horizon() {
     // §10: directions whose tangential part underflows the slope ratio (1e-310), the poles
     // themselves, and the horizon from both sides give unit upper-hemisphere normals that face
-    // the direction (at -z, where A = 0, the samplers return +z).
+    // the direction (at -z, where A = 0, the samplers return +z). Hammon's sampler too: a ray
+    // travelling straight up hits no facet (its rejection loop would never end) and gets +z.
     let tiny = 1e-310;
     let directions = [
         DVec3::Z,
@@ -239,6 +257,8 @@ fn visible_normals_stay_unit_at_the_poles_and_the_horizon() {
             let ms = [
                 Ggx(Roughness { x: 0.4, y: 0.9 }).sample_visible(w, &mut rng),
                 Beckmann(Roughness { x: 0.4, y: 0.9 }).sample_visible(w, &mut rng),
+                Normals::HammonRejection.sample(&Ggx(Roughness { x: 0.4, y: 0.9 }), -w, &mut rng),
+                Normals::HammonRejection.sample(&Beckmann(Roughness { x: 0.4, y: 0.9 }), -w, &mut rng),
             ];
             for m in ms {
                 assert!(m.is_finite() && (m.length() - 1.0).abs() < 1e-12 && m.z >= 0.0, "w {w}: normal {m}");
@@ -246,4 +266,39 @@ fn visible_normals_stay_unit_at_the_poles_and_the_horizon() {
             }
         }
     }
+}
+
+/// Directions of the lanes (one per lane, different, above and below the horizon), so that a
+/// lane given another lane's direction or normal is rejected too.
+const LANE_DIRECTIONS: [(f64, f64); 4] = [(30.0, 40.0), (135.0, 10.0), (60.0, 100.0), (100.0, 200.0)];
+/// GGX's own lane sampler on 4 lanes; Beckmann's (the trait's default) and Hammon's on 2.
+const LANE_TESTS: usize = 4 + 2 + 2;
+
+/// Draws [`SAMPLES`] normals per lane with `Normals::sample_lanes` (the side-by-side walk's
+/// sampler) and tests each lane's histogram against its own direction's law.
+fn check_lanes<N: Ndf, const L: usize>(ndf: &N, normals: Normals, level: f64, seed: u64, label: &str) {
+    let w: [DVec3; L] = std::array::from_fn(|i| dir(LANE_DIRECTIONS[i].0, LANE_DIRECTIONS[i].1));
+    let mut rng = Pcg64Mcg::new(0xfeed_1000 + seed as u128);
+    let mut counts = [[0u64; COS_BINS * PHI_BINS]; L];
+    for _ in 0..SAMPLES {
+        let m = normals.sample_lanes(ndf, w.map(|w| -w), &mut rng);
+        for (lane, m) in m.into_iter().enumerate() {
+            assert!(m.is_finite() && (m.length() - 1.0).abs() < 1e-12 && m.z >= 0.0, "{label}: bad normal {m}");
+            counts[lane][bin_of(m)] += 1;
+        }
+    }
+    for lane in 0..L {
+        let bins: Vec<WeightedBin> = counts[lane].iter().map(|&c| WeightedBin::of_count(c, SAMPLES)).collect();
+        let test = chi_square(&bins, &law(ndf, normals, w[lane]), SAMPLES, 5.0);
+        assert!(test.p_value > level, "{label} lane {lane}: histogram rejected\n{}", test.worst_cells(12));
+    }
+}
+
+#[test]
+fn lanes_draw_each_lanes_law() {
+    let level = sidak(0.01, FAMILY);
+    let r = Roughness { x: 0.5, y: 0.2 };
+    check_lanes::<_, 4>(&Ggx(r), Normals::Visible, level, 0, "ggx lanes");
+    check_lanes::<_, 2>(&Beckmann(r), Normals::Visible, level, 1, "beckmann lanes");
+    check_lanes::<_, 2>(&Ggx(r), Normals::HammonRejection, level, 2, "hammon lanes");
 }

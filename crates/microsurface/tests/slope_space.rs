@@ -7,9 +7,9 @@
 use microsurface::DVec3;
 use microsurface::ndf::{Ggx, Ndf, Roughness};
 use microsurface::slope::{ggx_polygon_mass, ggx_visible_polygon_probability};
+use numerics::quadrature::integrate_2d;
+use numerics::stats::{ChiSquare, WeightedBin, chi_square, sidak};
 use rand_pcg::Pcg64Mcg;
-use smithwalk::analysis::quadrature::integrate_2d;
-use smithwalk::analysis::stats::{ChiSquare, WeightedBin, chi_square, sidak};
 
 /// `P22` of anisotropic GGX (§1.2).
 fn p22(r: Roughness, x: f64, y: f64) -> f64 {

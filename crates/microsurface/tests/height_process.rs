@@ -19,8 +19,8 @@ use microsurface::height::{Flight, fly, other_side_depth};
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 use microsurface::random::exp1;
 use microsurface::smith::Smith;
+use numerics::stats::{WeightedBin, chi_square, sidak};
 use rand_pcg::Pcg64Mcg;
-use smithwalk::analysis::stats::{WeightedBin, chi_square, sidak};
 use statrs::distribution::{ContinuousCDF, Normal};
 
 const FLIGHTS: u64 = 200_000;
@@ -100,7 +100,7 @@ fn run<N: Ndf>(ndf: &N, seed: u128, level: f64) {
 
 /// Chi-square of `samples` over `BINS` bins that are equiprobable under the law of quantile
 /// function `quantile`.
-fn equiprobable(samples: &[f64], quantile: impl Fn(f64) -> f64) -> smithwalk::analysis::stats::ChiSquare {
+fn equiprobable(samples: &[f64], quantile: impl Fn(f64) -> f64) -> numerics::stats::ChiSquare {
     let edges: Vec<f64> = (0..=BINS).map(|k| quantile(k as f64 / BINS as f64)).collect();
     let mut counts = [0u64; BINS];
     for x in samples {

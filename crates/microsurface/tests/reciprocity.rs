@@ -15,8 +15,8 @@ use microsurface::nee::contribution;
 use microsurface::normals::Normals;
 use microsurface::smith::Smith;
 use microsurface::walk::{EnergyPolicy, Loss, Microsurface, Observer};
+use numerics::stats::sidak;
 use rand_pcg::Pcg64Mcg;
-use smithwalk::analysis::stats::sidak;
 use statrs::distribution::{ContinuousCDF, Normal};
 
 const PHOTONS: u64 = 400_000;

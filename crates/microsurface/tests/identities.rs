@@ -11,7 +11,7 @@ use microsurface::DVec3;
 use microsurface::facet::{hammon_exit_cdf, hammon_exit_cosine};
 use microsurface::fresnel;
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, beckmann_slope_marginal, ggx_slope_marginal};
-use smithwalk::analysis::quadrature::{integrate, integrate_2d};
+use numerics::quadrature::{integrate, integrate_2d};
 
 const THETAS: [f64; 8] = [5.0, 30.0, 60.0, 85.0, 95.0, 120.0, 150.0, 175.0];
 

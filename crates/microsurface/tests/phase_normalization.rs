@@ -39,10 +39,10 @@ use microsurface::fresnel;
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 use microsurface::random::open01;
 use microsurface::single;
+use numerics::quadrature::{gauss_legendre, integrate};
+use numerics::stats::sidak;
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
-use smithwalk::analysis::quadrature::{gauss_legendre, integrate};
-use smithwalk::analysis::stats::sidak;
 use statrs::function::gamma::ln_gamma;
 
 /// Gauss–Legendre nodes per patch and dimension of [`sphere_integral`].
