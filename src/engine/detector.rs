@@ -312,6 +312,17 @@ struct Deposit<const C: usize> {
     weight: [f64; C],
 }
 
+impl<const C: usize> Deposit<C> {
+    /// The two places the deposit goes, slot 0 (all orders) and its own slot: per slot, the
+    /// bin's index in arrays indexed like the tallies (`slot * 2 bins + hemisphere * bins +
+    /// bin`, `bins` a hemisphere's) and the albedo's (`2 slot + hemisphere`).
+    #[inline]
+    fn keys(&self, bins: usize) -> [(usize, usize); 2] {
+        let h = self.hemisphere as usize;
+        [0, self.slot].map(|slot| ((2 * slot + h) * bins + self.bin, 2 * slot + h))
+    }
+}
+
 /// The raw accumulators of one case: everything a detector measured, and all that a shard
 /// of a run must keep so that merged shards reproduce the unsplit run exactly.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -586,6 +597,16 @@ impl<const C: usize> Default for ChunkSums<C> {
 }
 
 impl<const C: usize> ChunkSums<C> {
+    /// Adds one photon's weight `w` in bin `key`.
+    #[inline]
+    fn add_to_bin(&mut self, key: usize, w: &[f64; C]) {
+        let b = &mut self.bins[key];
+        if b.photons == 0 {
+            self.touched.push(key);
+        }
+        b.add(w);
+    }
+
     /// Adds the sums to `tallies`, in fixed point; `bins` is the number of bins of a slot over
     /// both hemispheres.
     fn add_to(&self, tallies: &mut Tallies<C>, bins: usize) {
@@ -706,21 +727,14 @@ impl<const C: usize> Detector<C> {
         self.tallies.interactions += interactions;
     }
 
-    /// Adds a photon whose whole weight escaped at once, in deposit `d`: one conversion to
-    /// fixed point serves the accounted total and the photon's albedo tallies.
+    /// Adds a photon whose whole weight escaped at once, in deposit `d`, to the chunk's sums:
+    /// its bins, albedos and accounted total all get the same weight.
     #[inline]
     fn add_whole_photon(&mut self, d: &Deposit<C>) {
         self.chunk.accounted.add(&d.weight);
-        let bins = self.grid.bins();
-        let h = d.hemisphere as usize;
-        for slot in [0, d.slot] {
-            let key = (2 * slot + h) * bins + d.bin;
-            let b = &mut self.chunk.bins[key];
-            if b.photons == 0 {
-                self.chunk.touched.push(key);
-            }
-            b.add(&d.weight);
-            self.chunk.albedos[2 * slot + h].add(&d.weight);
+        for (bin, albedo) in d.keys(self.grid.bins()) {
+            self.chunk.add_to_bin(bin, &d.weight);
+            self.chunk.albedos[albedo].add(&d.weight);
         }
     }
 
@@ -734,10 +748,9 @@ impl<const C: usize> Detector<C> {
         if self.unit_hits.len() < (d.slot + 1) * bins {
             self.unit_hits.resize((d.slot + 1) * bins, 0);
         }
-        let i = d.hemisphere as usize * self.grid.bins() + d.bin;
-        for slot in [0, d.slot] {
-            self.tallies.orders[slot].albedo[d.hemisphere as usize].add_contribution(&c);
-            self.unit_hits[slot * bins + i] += 1;
+        for (bin, albedo) in d.keys(self.grid.bins()) {
+            self.tallies.orders[albedo / 2].albedo[albedo % 2].add_contribution(&c);
+            self.unit_hits[bin] += 1;
         }
         self.unsettled += 1;
         if self.unsettled == u32::MAX {
@@ -772,12 +785,9 @@ impl<const C: usize> Detector<C> {
     fn add_photon_in_flight(&mut self) {
         for key in self.photon.bins_reached.drain(..) {
             let b = &mut self.chunk.bins[key];
-            if b.photons == 0 {
-                self.chunk.touched.push(key);
-            }
             let photon = std::mem::replace(&mut b.photon, [0.0; C]);
             b.reached = false;
-            b.add(&photon);
+            self.chunk.add_to_bin(key, &photon);
         }
         for key in self.photon.albedos_reached.drain(..) {
             let sum = std::mem::take(&mut self.photon.albedos[key]);
@@ -813,17 +823,15 @@ impl<const C: usize> Observer<C> for Detector<C> {
         let d = self.deposit(order, side, dir, weight);
         self.reach_slot(d.slot);
         accumulate(&mut self.escaped, weight);
-        let (bins, h) = (self.grid.bins(), d.hemisphere as usize);
         let photon = &mut self.photon;
-        for slot in [0, d.slot] {
-            let key = (2 * slot + h) * bins + d.bin;
-            let b = &mut self.chunk.bins[key];
+        for (bin, albedo) in d.keys(self.grid.bins()) {
+            let b = &mut self.chunk.bins[bin];
             if !b.reached {
                 b.reached = true;
-                photon.bins_reached.push(key);
+                photon.bins_reached.push(bin);
             }
             accumulate(&mut b.photon, weight);
-            add_to_sum(&mut photon.albedos, &mut photon.albedos_reached, 2 * slot + h, weight);
+            add_to_sum(&mut photon.albedos, &mut photon.albedos_reached, albedo, weight);
         }
     }
 
