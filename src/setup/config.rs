@@ -261,23 +261,8 @@ pub enum MaterialConfig {
 
 /// A dielectric's `eta`: one number, so that a list gets an error that says why.
 fn relative_index<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    struct Visitor;
-    impl serde::de::Visitor<'_> for Visitor {
-        type Value = f64;
-        fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-            f.write_str("one number, the relative index n_inside / n_outside of every channel (an index per channel, dispersion, is not modelled)")
-        }
-        fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<f64, E> {
-            Ok(v)
-        }
-        fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<f64, E> {
-            Ok(v as f64)
-        }
-        fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<f64, E> {
-            Ok(v as f64)
-        }
-    }
-    d.deserialize_any(Visitor)
+    let what = "one number, the relative index n_inside / n_outside of every channel (an index per channel, dispersion, is not modelled)";
+    number_or_list::<D, 3>(d, what)?.map_err(|_| serde::de::Error::invalid_type(serde::de::Unexpected::Seq, &what))
 }
 
 fn fresnel_none() -> FresnelKind {
