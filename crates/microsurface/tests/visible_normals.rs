@@ -53,13 +53,17 @@ fn expected(density: impl Fn(DVec3) -> f64) -> Vec<f64> {
                 let s = (1.0 - u * u).max(0.0).sqrt();
                 density(DVec3::new(s * phi.cos(), s * phi.sin(), u))
             };
-            // 4 x 4 sub-panels per bin, so that the adaptive rule sees narrow features.
+            // 4 x 4 sub-panels per bin, so that the adaptive rule sees narrow features. An
+            // absolute tolerance of 1e-8 a sub-panel bounds a bin's error by 1.6e-7, 0.03 of a
+            // count in 200 000 draws, against a standard deviation of at least 2.2 in a pooled
+            // cell (expected count 5 or more); a tighter tolerance only slows the kink at
+            // w·m = 0 (1e-11 took 30 s of this file's run, 1e-8 takes 13 s).
             let mut sum = 0.0;
             for a in 0..4 {
                 for b in 0..4 {
                     let su = (u.0 + (u.1 - u.0) * a as f64 / 4.0, u.0 + (u.1 - u.0) * (a + 1) as f64 / 4.0);
                     let sp = (p.0 + (p.1 - p.0) * b as f64 / 4.0, p.0 + (p.1 - p.0) * (b + 1) as f64 / 4.0);
-                    sum += integrate_2d(f, su, sp, 1e-11).0;
+                    sum += integrate_2d(f, su, sp, 1e-8).0;
                 }
             }
             out.push(sum);
