@@ -27,7 +27,7 @@
 //! `smith.rs`: case 0, all orders, chi-square 476389 on 128 dof); free flights 2% too long in
 //! `height.rs` (case 4, order-1 transmission, z = -3.95: caught, narrowly). It shares the
 //! facets with the walk, so a facet bug (the outside `eta` used inside) passes it; that is
-//! inside_single_scattering.rs's job. Runtime: about 11 s on 2 cores.
+//! the job of the physics crate's walk_lobes.rs. Runtime: about 11 s on 2 cores.
 
 mod common;
 

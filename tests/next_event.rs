@@ -6,7 +6,7 @@
 //! the sampler: both estimators draw the hit normals with `Normals::sample` and the outgoing
 //! directions with `Facet::interact`, so a wrong visible-normal sampler or a wrong facet
 //! passes it. Those are checked by single_scattering.rs, visible_normals.rs, slope_space.rs,
-//! phase_normalization.rs and inside_single_scattering.rs, and whole walks against
+//! phase_normalization.rs and the physics crate's walk_lobes.rs, and whole walks against
 //! independent per-order tables (energy.rs) and a height-form walk (height_walk.rs).
 //!
 //! Seven cases (GGX conductor F = 1 and exact Fresnel anisotropic at 70 deg, dielectric from
