@@ -4,11 +4,18 @@
 //! * Smooth limit: with alpha -> 0, F0 = 0 and albedo 1, the fit's diffuse term at normal
 //!   incidence integrates to exactly 1 (the 1.05 = 21/20 normalization of the Fresnel-weighted
 //!   exit, docs/theory.md §4.5); quadrature over the detector's bins must reproduce that.
+//! * At fixed direction pairs, against the fit evaluated from the slides' formulas alone by
+//!   `scripts/hammon_fit_reference.py` (plain Python, its own GGX D and Schlick F): four cases
+//!   covering smooth and rough, small and large F0 and albedo, normal and grazing light, both
+//!   parts, to 1e-12 relative (the same formula in two double-precision evaluations).
 //! * Beside the simulation (alpha 0.5, F0 0.02, albedo 0.75, 10^6 photons): the fit is an
 //!   approximation fitted to a different walk (symmetric Lambda, rejection normals), so the test
 //!   records the measured all-order albedo difference and only asserts it stays below 10 %.
 
-use smithwalk::analysis::models::{HammonFitPart, hammon_fit_bins};
+mod common;
+
+use common::dir;
+use smithwalk::analysis::models::{HammonFitPart, hammon_fit_bins, hammon_fit_lobe};
 use smithwalk::engine::detector::Grid;
 use smithwalk::setup::cases::expand;
 use smithwalk::setup::config::Config;
@@ -40,4 +47,31 @@ fn the_fit_beside_the_simulation() {
     let measured = e.reflected[0];
     println!("hammon facet alpha 0.5, 30 deg: simulated albedo {measured:.4}, Hammon's fit {fit:.4}");
     assert!((fit - measured).abs() < 0.1 * measured, "fit {fit} vs simulation {measured}");
+}
+
+/// `python3 scripts/hammon_fit_reference.py`: (alpha, F0, albedo, light (theta, phi) deg,
+/// detector (theta, phi) deg, order-1 lobe, all-order lobe).
+#[allow(clippy::type_complexity)]
+const SLIDES: [(f64, f64, f64, (f64, f64), (f64, f64), f64, f64); 4] = [
+    (0.5, 0.04, 0.8, (30.0, 0.0), (45.0, 180.0), 1.613394817624880e-01, 1.875646580631347e-01),
+    (0.2, 0.5, 0.3, (60.0, 10.0), (20.0, 250.0), 1.318766366581096e-01, 1.338370234035932e-01),
+    (1.0, 0.02, 0.95, (0.0, 0.0), (70.0, 90.0), 7.140582280803184e-02, 1.071810442948610e-01),
+    (0.8, 0.1, 0.5, (80.0, 0.0), (80.0, 180.0), 6.963391290335526e-02, 7.365907766167472e-02),
+];
+
+#[test]
+fn the_fit_is_the_slides_formula_at_fixed_directions() {
+    for (alpha, f0, albedo, light, view, single, all) in SLIDES {
+        let (wi, wo) = (dir(light.0, light.1), dir(view.0, view.1));
+        for (part, expected) in [(HammonFitPart::Single, single), (HammonFitPart::All, all)] {
+            let value = hammon_fit_lobe(alpha, f0, albedo, wi, wo, part);
+            assert!(
+                (value - expected).abs() <= 1e-12 * expected,
+                "alpha {alpha}, F0 {f0}, albedo {albedo}, {light:?} -> {view:?}, {part:?}: {value} against {expected}"
+            );
+        }
+    }
+    // Below the horizon on either side the fit has no lobe.
+    assert_eq!(hammon_fit_lobe(0.5, 0.04, 0.8, dir(100.0, 0.0), dir(30.0, 0.0), HammonFitPart::All), 0.0);
+    assert_eq!(hammon_fit_lobe(0.5, 0.04, 0.8, dir(30.0, 0.0), dir(100.0, 0.0), HammonFitPart::All), 0.0);
 }
