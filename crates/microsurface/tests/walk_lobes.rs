@@ -420,3 +420,10 @@ fn wangs_chains_at_order_one_are_single_scattering_and_conserve_energy() {
         assert!(z.abs() < two_sided_z(level), "{name}: R + T = {}, z = {z:.2}", r + t);
     }
 }
+
+#[test]
+#[should_panic(expected = "cannot split")]
+fn side_by_side_refuses_a_dielectric_that_would_split() {
+    // Its lanes have nowhere to keep a second branch: splitting there would drop light.
+    Walk::new(Ggx(Roughness::isotropic(0.5)), Dielectric { eta: 1.5 }, SPLIT, dir(30.0, 0.0)).side_by_side(10, 61);
+}
