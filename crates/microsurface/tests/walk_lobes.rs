@@ -78,12 +78,16 @@ struct Tally {
     sum: Vec<f64>,
     sum_sq: Vec<f64>,
     photons: u64,
+    /// Whether an escape without light fails the test: the walk and the chains report only
+    /// escapes that carry light (the program's detector counts the photons reaching each
+    /// bin); next-event deposits may underflow to 0.
+    strict: bool,
 }
 
 impl Tally {
     fn new() -> Self {
         let n = 2 * CLASSES * SLOTS;
-        Tally { photon: vec![0.0; n], sum: vec![0.0; n], sum_sq: vec![0.0; n], ..Default::default() }
+        Tally { photon: vec![0.0; n], sum: vec![0.0; n], sum_sq: vec![0.0; n], strict: true, ..Default::default() }
     }
 
     fn slot(side: Side, class: usize, bin: usize) -> usize {
@@ -124,6 +128,7 @@ impl Tally {
 
 impl Observer<1> for Tally {
     fn escape(&mut self, order: u32, side: Side, dir: DVec3, weight: &[f64; 1]) {
+        assert!(weight[0] > 0.0 || !self.strict, "an escape without light at order {order}");
         let class = (order as usize).clamp(1, 4) - 1;
         let bin = bin_of(dir);
         for c in [class, ALL] {
@@ -184,7 +189,8 @@ impl<N: Ndf, F: Facet<1>> Walk<N, F> {
 
     /// `photons` photons estimated by next-event estimation at every hit, 4 directions each.
     fn next_event(&self, photons: u64, seed: u128) -> Tally {
-        let (mut tally, mut rng, mut stack) = (Tally::new(), Pcg64Mcg::new(seed), Vec::new());
+        let (mut tally, mut rng, mut stack) =
+            (Tally { strict: false, ..Tally::new() }, Pcg64Mcg::new(seed), Vec::new());
         let mut nee_rng = Pcg64Mcg::new(seed ^ 0x5eed);
         for _ in 0..photons {
             let mut nee = NextEvent {
@@ -426,4 +432,47 @@ fn wangs_chains_at_order_one_are_single_scattering_and_conserve_energy() {
 fn side_by_side_refuses_a_dielectric_that_would_split() {
     // Its lanes have nowhere to keep a second branch: splitting there would drop light.
     Walk::new(Ggx(Roughness::isotropic(0.5)), Dielectric { eta: 1.5 }, SPLIT, dir(30.0, 0.0)).side_by_side(10, 61);
+}
+
+#[test]
+fn the_position_free_form_reports_refraction_as_an_invalid_loss() {
+    // §7.1: the depth profile has no form for a change of side; the chain must stop the
+    // refracted light as an invalid loss, not carry a NaN on.
+    #[derive(Default)]
+    struct Outcome {
+        escaped: f64,
+        invalid: f64,
+    }
+    impl Observer<1> for Outcome {
+        fn escape(&mut self, order: u32, _: Side, d: DVec3, weight: &[f64; 1]) {
+            assert!(d.is_finite() && weight[0].is_finite() && weight[0] > 0.0, "order {order}: {d}, {weight:?}");
+            self.escaped += weight[0];
+        }
+        fn lose(&mut self, loss: Loss, weight: &[f64; 1]) {
+            assert_eq!(loss, Loss::Invalid);
+            self.invalid += weight[0];
+        }
+    }
+    let (mut outcome, mut rng) = (Outcome::default(), Pcg64Mcg::new(71));
+    let ndf = Ggx(Roughness::isotropic(0.5));
+    for _ in 0..10_000 {
+        chain::trace(
+            &mut DepthProfile::default(),
+            &ndf,
+            &Dielectric { eta: 1.5 },
+            &CHOOSE,
+            dir(30.0, 0.0),
+            &mut rng,
+            &mut outcome,
+        );
+    }
+    // Most light refracts at the first facet (the order-1 reflection is about 4%).
+    let n = 10_000.0;
+    println!("escaped {}, invalid {} per photon", outcome.escaped / n, outcome.invalid / n);
+    assert!(
+        outcome.invalid / n > 0.8 && outcome.escaped / n < 0.2,
+        "escaped {}, invalid {}",
+        outcome.escaped,
+        outcome.invalid
+    );
 }
