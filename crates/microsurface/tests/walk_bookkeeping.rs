@@ -8,13 +8,15 @@
 //!   whose largest channel keeps weight 1 is never reweighted.
 //! * A path that never escapes is stopped as a runaway after 2^20 interactions; a facet
 //!   that returns a non-finite direction, or a weight that is infinite, negative or NaN, stops
-//!   the path as an invalid loss carrying its weight.
+//!   the path as an invalid loss carrying its weight; next-event estimation passes such a
+//!   loss on to its sink.
 //! * Side by side, every photon asked for is walked and ended exactly once, for any number of
 //!   photons (none, fewer than the lanes, not a multiple of them).
 
 use microsurface::DVec3;
 use microsurface::facet::{Branch, Facet, Interaction, Lambertian, Side};
 use microsurface::ndf::{Ggx, Ndf, Roughness};
+use microsurface::nee::NextEvent;
 use microsurface::normals::Normals;
 use microsurface::smith::Smith;
 use microsurface::walk::{EnergyPolicy, Loss, Microsurface, Observer, RUNAWAY_ORDER};
@@ -152,4 +154,21 @@ fn side_by_side_walks_and_ends_every_photon_once() {
         assert_eq!(record.escapes.len() as u64, photons, "{photons} photons: one escape each");
         assert!(record.escapes.iter().all(|&(k, w)| k >= 1 && w == [1.0]), "{photons} photons");
     }
+}
+
+#[test]
+fn next_event_estimation_passes_losses_on() {
+    let facet = Fixed(Branch { dir: DVec3::new(f64::NAN, 0.0, 1.0), weight: [1.0], crosses: false });
+    let (mut sink, mut rng, mut stack) = (Record::default(), Pcg64Mcg::new(83), Vec::new());
+    let mut nee_rng = Pcg64Mcg::new(84);
+    let mut nee = NextEvent {
+        ndf: &SURFACE.ndf,
+        normals: SURFACE.normals,
+        facet: &Lambertian { albedo: [1.0] },
+        sink: &mut sink,
+        rng: &mut nee_rng,
+        samples: 1,
+    };
+    SURFACE.trace(&facet, &SPLIT, DVec3::new(0.6, 0.0, 0.8), &mut rng, &mut stack, &mut nee);
+    assert_eq!(sink.losses, vec![(Loss::Invalid, [1.0])]);
 }
