@@ -10,17 +10,24 @@
 //!   that returns a non-finite direction, or a weight that is infinite, negative or NaN, stops
 //!   the path as an invalid loss carrying its weight; next-event estimation passes such a
 //!   loss on to its sink.
+//! * A facet says it may split exactly when its interaction returns two branches (the
+//!   side-by-side walk relies on it).
+//! * A depth profile whose light has all escaped lets nothing escape any more (§7.1).
 //! * Side by side, every photon asked for is walked and ended exactly once, for any number of
 //!   photons (none, fewer than the lanes, not a multiple of them).
 
 use microsurface::DVec3;
-use microsurface::facet::{Branch, Facet, Interaction, Lambertian, Side};
+use microsurface::chain::Visibility;
+use microsurface::facet::{
+    Branch, Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Interaction, Lambertian, Side,
+};
 use microsurface::ndf::{Ggx, Ndf, Roughness};
 use microsurface::nee::NextEvent;
 use microsurface::normals::Normals;
+use microsurface::position_free::DepthProfile;
 use microsurface::smith::Smith;
 use microsurface::walk::{EnergyPolicy, Loss, Microsurface, Observer, RUNAWAY_ORDER};
-use rand::Rng;
+use rand::{Rng, RngExt};
 use rand_pcg::Pcg64Mcg;
 
 const SURFACE: Microsurface<Ggx> =
@@ -171,4 +178,43 @@ fn next_event_estimation_passes_losses_on() {
     };
     SURFACE.trace(&facet, &SPLIT, DVec3::new(0.6, 0.0, 0.8), &mut rng, &mut stack, &mut nee);
     assert_eq!(sink.losses, vec![(Loss::Invalid, [1.0])]);
+}
+
+/// Whether `facet` returned two branches in 1000 interactions at random incidences.
+fn splits<F: Facet<1>>(facet: &F) -> bool {
+    let mut rng = Pcg64Mcg::new(85);
+    (0..1000).any(|_| {
+        let m = DVec3::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), 1.0).normalize();
+        let w = (m + DVec3::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), 0.0)).normalize();
+        matches!(facet.interact(w, m, Side::Outside, &mut rng), Interaction::Two(..))
+    })
+}
+
+#[test]
+fn a_facet_may_split_exactly_when_it_returns_two_branches() {
+    let conductor = Conductor::<1> { fresnel: ConductorFresnel::Exact { eta: [0.2], k: [3.0] } };
+    let lambertian = Lambertian { albedo: [0.5] };
+    let hammon = Hammon { f0: [0.04], albedo: [0.5] };
+    let dielectric = Dielectric { eta: 1.5 };
+    assert!(!conductor.may_split() && !splits(&conductor));
+    assert!(!Facet::<1>::may_split(&lambertian) && !splits(&lambertian));
+    assert!(Facet::<1>::may_split(&hammon) && splits(&hammon));
+    assert!(Facet::<1>::may_split(&dielectric) && splits(&dielectric));
+    // The side-by-side walk takes exactly the policies and facets that never split.
+    let never = EnergyPolicy { split: false, threshold: 0.1 };
+    assert!(SPLIT.never_splits(&conductor) && SPLIT.never_splits(&lambertian));
+    assert!(!SPLIT.never_splits(&hammon) && !SPLIT.never_splits::<_, 1>(&dielectric));
+    assert!(never.never_splits(&hammon) && never.never_splits::<_, 1>(&dielectric));
+}
+
+#[test]
+fn a_depth_profile_whose_light_escaped_lets_nothing_escape() {
+    // Straight up (Lambda = 0 for GGX) everything escapes; what is left has no mass.
+    let mut profile = DepthProfile::default();
+    profile.enter(1.3);
+    profile.down(2.0);
+    assert_eq!(profile.up(0.0), 1.0);
+    for lambda in [0.0, 0.5, 3.0] {
+        assert_eq!(profile.up(lambda), 0.0, "after everything escaped, up({lambda})");
+    }
 }
