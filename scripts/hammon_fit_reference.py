@@ -49,4 +49,4 @@ CASES = [
 if __name__ == "__main__":
     for alpha, f0, albedo, light, view in CASES:
         single, total = (fit(alpha, f0, albedo, light, view, m) for m in (False, True))
-        print(f"({alpha}, {f0}, {albedo}, {light}, {view}, {single:.15e}, {total:.15e}),")
+        print(f"({alpha}, {f0}, {albedo}, {light}, {view}, {single!r}, {total!r}),")

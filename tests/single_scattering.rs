@@ -4,15 +4,17 @@
 //! * Histograms: for each case below, 10^6 photons on a 16 x 32 grid; the expected energy of
 //!   every bin is the single-scattering lobe integrated over the bin by adaptive quadrature
 //!   (`models::single_scattering_bins`). Per-bin variances come from the per-photon second
-//!   moments (weighted histograms); cells with an expected count below 5 are pooled. Each
-//!   chi-square test runs at the Sidak level keeping the family (all 8 tests) at 0.01.
+//!   moments (weighted histograms); cells with an expected count below 5 are pooled, and at
+//!   least 16 cells must remain (a lobe wrongly expected to be zero would otherwise pool into
+//!   one untested cell). Beside each chi-square, the order-1 albedo against the bins' sum by a z
+//!   test. Each test runs at the Sidak level keeping the family at 0.01.
 //! * Albedo: at 10^7 photons the order-1 albedo of the GGX conductor with F = 1 is compared
 //!   with the quadrature values of docs/theory.md §9.4 (independent scripts; 1 - ln 2 in closed
 //!   form at alpha 1, normal incidence), within 4 standard errors (SE about 1.5e-4).
 
 mod common;
 
-use common::{albedo, mono, simulate, weighted_bins};
+use common::{albedo, mono, simulate, two_sided_z, weighted_bins};
 use smithwalk::analysis::models::single_scattering_bins;
 use smithwalk::analysis::stats::{chi_square, sidak};
 use smithwalk::engine::detector::Hemisphere;
@@ -73,7 +75,7 @@ const CASES: [HistogramCase; 6] = [
 #[test]
 fn order_one_histograms_match_single_scattering() {
     let tests: usize = CASES.iter().map(|c| c.hemispheres.len()).sum();
-    let level = sidak(0.01, tests);
+    let level = sidak(0.01, 2 * tests);
     for (i, c) in CASES.iter().enumerate() {
         let toml = format!(
             "paths = 1_000_000\nseed = {seed}\n[surface]\n{}\n[material]\n{}\n[incident]\ntheta_deg = {}\nphi_deg = {}\n[detector]\ncos_theta_bins = 16\nphi_bins = 32\nmax_order = 2\n",
@@ -88,6 +90,15 @@ fn order_one_histograms_match_single_scattering() {
         for &h in c.hemispheres {
             let expected = single_scattering_bins(&sim.cases[0], &d.grid, h, 1e-10).expect("closed form applies");
             let test = chi_square(&weighted_bins(d, 1, h), &expected, d.tallies.photons, 5.0);
+            // A lobe expected to be zero almost everywhere pools into one untested cell: the
+            // test must keep cells, and the order-1 albedo must match the bins' sum.
+            let (e1, se) = albedo(d, 1, h);
+            let total: f64 = expected.iter().sum();
+            assert!(test.dof >= 16, "case {i} {h:?}: only {} cells tested", test.dof);
+            assert!(
+                (e1 - total).abs() < two_sided_z(level) * se,
+                "case {i} {h:?}: E1 = {e1} +- {se}, single scattering {total}"
+            );
             assert!(
                 test.p_value > level,
                 "case {i} ({} / {} at {} deg) {h:?}: order-1 histogram rejected\n{}",
@@ -185,6 +196,7 @@ fn order_one_of_scattering_facets_matches_single_scattering() {
             "{material} {alpha} at {theta} deg: chi2 {:.1}, dof {}, p {:.3e}",
             test.statistic, test.dof, test.p_value
         );
+        assert!(test.dof >= 16, "{material} {alpha} at {theta} deg: only {} cells tested", test.dof);
         assert!(test.p_value > level, "{material} {alpha} at {theta} deg: order 1 rejected\n{}", test.worst_cells(10));
     }
 }

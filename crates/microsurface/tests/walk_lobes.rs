@@ -479,3 +479,20 @@ fn the_position_free_form_reports_refraction_as_an_invalid_loss() {
         outcome.invalid
     );
 }
+
+#[test]
+fn single_scattering_has_no_lobe_on_the_wrong_side() {
+    // §5: reflection needs both directions above, transmission the light above and the
+    // detector below; the formulas return 0 elsewhere, not a value of the wrong geometry.
+    let ndf = Ggx(Roughness::isotropic(0.5));
+    let f = |c: f64| fresnel::dielectric(1.5, c);
+    let (up, down) = (dir(30.0, 0.0), dir(140.0, 170.0));
+    assert!(single::reflection(&ndf, up, dir(40.0, 180.0), f) > 0.0);
+    assert!(single::transmission(&ndf, up, down, 1.5, f) > 0.0);
+    for (wi, wo) in [(up, down), (down, up), (down, dir(40.0, 180.0))] {
+        assert_eq!(single::reflection(&ndf, wi, wo, f), 0.0, "reflection {wi} -> {wo}");
+    }
+    for (wi, wo) in [(up, dir(40.0, 180.0)), (down, down), (down, up)] {
+        assert_eq!(single::transmission(&ndf, wi, wo, 1.5, f), 0.0, "transmission {wi} -> {wo}");
+    }
+}
