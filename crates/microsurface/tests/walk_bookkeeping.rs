@@ -13,6 +13,7 @@
 //! * A facet says it may split exactly when its interaction returns two branches (the
 //!   side-by-side walk relies on it).
 //! * A depth profile whose light has all escaped lets nothing escape any more (§7.1).
+//! * The interactions a photon returns are the hits of all its rays, split or not.
 //! * Side by side, every photon asked for is walked and ended exactly once, for any number of
 //!   photons (none, fewer than the lanes, not a multiple of them).
 
@@ -40,6 +41,7 @@ struct Record<const C: usize> {
     escapes: Vec<(u32, [f64; C])>,
     losses: Vec<(Loss, [f64; C])>,
     ended: u64,
+    hits: u64,
 }
 
 impl<const C: usize> Observer<C> for Record<C> {
@@ -51,6 +53,9 @@ impl<const C: usize> Observer<C> for Record<C> {
     }
     fn end_photon(&mut self, _interactions: u64) {
         self.ended += 1;
+    }
+    fn hit(&mut self, _order: u32, _tau: f64, _side: Side, _d: DVec3, _weight: &[f64; C]) {
+        self.hits += 1;
     }
 }
 
@@ -217,4 +222,13 @@ fn a_depth_profile_whose_light_escaped_lets_nothing_escape() {
     for lambda in [0.0, 0.5, 3.0] {
         assert_eq!(profile.up(lambda), 0.0, "after everything escaped, up({lambda})");
     }
+}
+
+#[test]
+fn the_interactions_of_split_photons_are_their_hits() {
+    // A split ray carries its parent's order on; the count a photon returns is the hits of all
+    // its rays, not their orders.
+    let (record, interactions) = trace::<_, 1>(&Dielectric { eta: 1.5 }, &SPLIT, 2_000);
+    assert!(record.escapes.len() > 3_000, "the photons split");
+    assert_eq!(interactions, record.hits);
 }
