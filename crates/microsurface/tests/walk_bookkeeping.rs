@@ -6,6 +6,8 @@
 //!   facets of albedos `rho_c`, every escape of order `k` carries `rho_c^k` times a factor
 //!   common to all channels; Russian roulette looks at the largest channel only, so a path
 //!   whose largest channel keeps weight 1 is never reweighted.
+//! * A random choice between two branches is proportional to the weight each carries, so the
+//!   path keeps the sum of the two (§4.6).
 //! * A path that never escapes is stopped as a runaway after 2^20 interactions; a facet
 //!   that returns a non-finite direction, or a weight that is infinite, negative or NaN, stops
 //!   the path as an invalid loss carrying its weight; next-event estimation passes such a
@@ -231,4 +233,37 @@ fn the_interactions_of_split_photons_are_their_hits() {
     let (record, interactions) = trace::<_, 1>(&Dielectric { eta: 1.5 }, &SPLIT, 2_000);
     assert!(record.escapes.len() > 3_000, "the photons split");
     assert_eq!(interactions, record.hits);
+}
+
+/// A facet that always offers the same two branches.
+struct FixedPair(Branch<1>, Branch<1>);
+
+impl Facet<1> for FixedPair {
+    fn interact<R: Rng + ?Sized>(&self, _w: DVec3, _m: DVec3, _side: Side, _rng: &mut R) -> Interaction<1> {
+        Interaction::Two(self.0, self.1)
+    }
+    fn may_split(&self) -> bool {
+        true
+    }
+    fn phase<N: Ndf, R: Rng + ?Sized>(&self, _: &N, _: DVec3, _: DVec3, _: Side, _: bool, _: &mut R) -> [f64; 1] {
+        unreachable!("not used by the walk")
+    }
+}
+
+#[test]
+fn a_random_choice_is_proportional_to_the_weight_carried() {
+    // §4.6: branch a (factor 0.3) is chosen with probability 0.3 / 0.5 and b (0.2) with
+    // 0.2 / 0.5, each divided by its probability: whichever is chosen, the path carries 0.5
+    // of its weight on, so an escape of order k carries exactly 0.5^k (no roulette here).
+    // a heads down (always hits again), b up at 80 deg (often hits again).
+    let pair = FixedPair(
+        Branch { dir: DVec3::new(0.3, 0.0, -1.0).normalize(), weight: [0.3], crosses: false },
+        Branch { dir: DVec3::new(-5.7, 0.0, 1.0).normalize(), weight: [0.2], crosses: false },
+    );
+    let (record, _) = trace(&pair, &EnergyPolicy { split: false, threshold: 0.0 }, 5_000);
+    assert!(record.escapes.iter().any(|&(k, _)| k >= 3), "no high orders reached");
+    for &(k, w) in &record.escapes {
+        let expected = 0.5f64.powi(k as i32);
+        assert!((w[0] - expected).abs() <= 1e-14 * expected, "order {k}: {w:?}, expected {expected}");
+    }
 }
