@@ -172,7 +172,8 @@ fn order_one_of_scattering_facets_matches_single_scattering() {
     // Lambertian and Hammon facets on GGX and Beckmann (§5: the visible-normal integral by a
     // Gauss–Legendre rule, on the [DB23] cap for GGX and in the aligned slope frame for
     // Beckmann, then a 12 x 12 Gauss–Legendre rule over each bin), 10^6 photons, 8 x 16 bins,
-    // cells with expected count < 5 pooled, Sidak family level 0.01 over the 7 cases.
+    // cells with expected count < 5 pooled, at least 16 cells left, and the order-1 albedo
+    // against the bins' sum by a z test; Sidak family level 0.01 over the 14 tests.
     let cases = [
         ("alpha = 0.3", "kind = \"diffuse\"\nalbedo = 0.8", 0.0),
         ("alpha = [[0.9, 0.4]]", "kind = \"diffuse\"", 80.0),
@@ -182,10 +183,10 @@ fn order_one_of_scattering_facets_matches_single_scattering() {
         ("ndf = \"beckmann\"\nalpha = [[1.0, 0.3]]", "kind = \"diffuse\"", 70.0),
         ("ndf = \"beckmann\"\nalpha = 0.7", "kind = \"hammon\"\nf0 = 0.04\nalbedo = 0.75", 84.0),
     ];
-    let level = sidak(0.01, cases.len());
+    let level = sidak(0.01, 2 * cases.len());
     for (i, (alpha, material, theta)) in cases.into_iter().enumerate() {
         let toml = format!(
-            "paths = 1_000_000\nseed = {}\n[surface]\n{alpha}\n[material]\n{material}\n[incident]\ntheta_deg = {theta}\nphi_deg = 15\n[detector]\ncos_theta_bins = 8\nphi_bins = 16\nmax_order = 2\n",
+            "paths = 1_000_000\nseed = {}\n[surface]\n{alpha}\n[material]\n{material}\n[incident]\ntheta_deg = {theta}\nphi_deg = 55\n[detector]\ncos_theta_bins = 8\nphi_bins = 16\nmax_order = 2\n",
             150 + i
         );
         let sim = simulate(&toml, 2);
@@ -197,6 +198,13 @@ fn order_one_of_scattering_facets_matches_single_scattering() {
             test.statistic, test.dof, test.p_value
         );
         assert!(test.dof >= 16, "{material} {alpha} at {theta} deg: only {} cells tested", test.dof);
+        let (e1, se) = albedo(d, 1, Hemisphere::R);
+        let total: f64 = expected.iter().sum();
+        println!("{material} {alpha} at {theta} deg: E1 {e1:.5} +- {se:.5}, single scattering {total:.5}");
+        assert!(
+            (e1 - total).abs() < two_sided_z(level) * se,
+            "{material} {alpha} at {theta} deg: E1 = {e1} +- {se}, single scattering {total}"
+        );
         assert!(test.p_value > level, "{material} {alpha} at {theta} deg: order 1 rejected\n{}", test.worst_cells(10));
     }
 }
