@@ -150,3 +150,15 @@ fn hammon_exit_lobe() {
         assert!((0.0..=1.0).contains(&c) && (hammon_exit_cdf(c) - u).abs() < 1e-12, "u = {u}: c = {c}");
     }
 }
+
+#[test]
+fn the_root_finder_converges_where_newton_alone_would_not() {
+    // f = atan(20 (x - 0.7)): from far away a Newton step overshoots the bracket [0, 1], so
+    // the safeguard must bisect; from any start the root is found to full precision.
+    let f = |x: f64| (20.0 * (x - 0.7)).atan();
+    let df = |x: f64| 20.0 / (1.0 + 400.0 * (x - 0.7) * (x - 0.7));
+    for x0 in [0.0, 0.05, 0.3, 0.69, 0.95, 1.0] {
+        let x = microsurface::roots::newton_bisect(f, df, 0.0, 1.0, x0);
+        assert!((x - 0.7).abs() < 1e-14, "from {x0}: {x}");
+    }
+}
