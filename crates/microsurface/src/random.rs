@@ -116,23 +116,31 @@ mod tests {
         }
     }
 
+    /// A generator that always returns the same 64 bits.
+    struct Fixed(u64);
+    impl rand::TryRng for Fixed {
+        type Error = std::convert::Infallible;
+        fn try_next_u32(&mut self) -> Result<u32, Self::Error> {
+            Ok(self.0 as u32)
+        }
+        fn try_next_u64(&mut self) -> Result<u64, Self::Error> {
+            Ok(self.0)
+        }
+        fn try_fill_bytes(&mut self, _: &mut [u8]) -> Result<(), Self::Error> {
+            unimplemented!()
+        }
+    }
+
+    /// `open01` of the smallest draw is half a grid step above 0, so `ln(u)` is finite.
+    #[test]
+    fn open01_of_the_smallest_draw_is_positive() {
+        assert_eq!(open01(&mut Fixed(0)), 0.5 * TWO_POW_M53);
+    }
+
     /// Against `cos` and `sin` of the angle the bits encode, at draws that hit every sector,
     /// both sector edges and the middle.
     #[test]
     fn azimuth_is_the_cosine_and_sine_of_the_encoded_angle() {
-        struct Fixed(u64);
-        impl rand::TryRng for Fixed {
-            type Error = std::convert::Infallible;
-            fn try_next_u32(&mut self) -> Result<u32, Self::Error> {
-                Ok(self.0 as u32)
-            }
-            fn try_next_u64(&mut self) -> Result<u64, Self::Error> {
-                Ok(self.0)
-            }
-            fn try_fill_bytes(&mut self, _: &mut [u8]) -> Result<(), Self::Error> {
-                unimplemented!()
-            }
-        }
         let mut random = rand_pcg::Pcg64Mcg::seed_from_u64(3);
         let offsets = [0u64, 1 << 55, (1 << 56) - 1, random.next_u64() >> 8, random.next_u64() >> 8];
         for k in 0..SECTORS as u64 {
