@@ -103,25 +103,30 @@ fn roulette_looks_at_the_largest_channel_only() {
     assert!(record.escapes.iter().all(|&(_, w)| (w[0] - 0.1).abs() < 1e-15), "roulette weights");
 }
 
-/// A facet that always returns `branch`.
-struct Fixed(Branch<1>);
+/// A facet that always offers the same interaction, one branch or two.
+struct Offers(Interaction<1>);
 
-impl Facet<1> for Fixed {
+impl Facet<1> for Offers {
     fn interact<R: Rng + ?Sized>(&self, _w: DVec3, _m: DVec3, _side: Side, _rng: &mut R) -> Interaction<1> {
-        Interaction::One(self.0)
+        self.0
     }
     fn may_split(&self) -> bool {
-        false
+        matches!(self.0, Interaction::Two(..))
     }
     fn phase<N: Ndf, R: Rng + ?Sized>(&self, _: &N, _: DVec3, _: DVec3, _: Side, _: bool, _: &mut R) -> [f64; 1] {
         unreachable!("not used by the walk")
     }
 }
 
+/// A facet that always returns `branch`.
+fn always(branch: Branch<1>) -> Offers {
+    Offers(Interaction::One(branch))
+}
+
 #[test]
 fn a_path_that_never_escapes_is_a_runaway() {
     // Straight down after every facet: no flight ever escapes.
-    let down = Fixed(Branch { dir: DVec3::NEG_Z, weight: [1.0], crosses: false });
+    let down = always(Branch { dir: DVec3::NEG_Z, weight: [1.0], crosses: false });
     let (record, interactions) = trace(&down, &SPLIT, 2);
     assert!(record.escapes.is_empty());
     assert_eq!(record.losses, vec![(Loss::Runaway, [1.0]); 2]);
@@ -139,7 +144,7 @@ fn a_non_finite_direction_or_an_invalid_weight_is_an_invalid_loss() {
         (DVec3::Z, f64::NAN),
     ];
     for (dir, weight) in cases {
-        let (record, interactions) = trace(&Fixed(Branch { dir, weight: [weight], crosses: false }), &SPLIT, 3);
+        let (record, interactions) = trace(&always(Branch { dir, weight: [weight], crosses: false }), &SPLIT, 3);
         assert!(record.escapes.is_empty(), "{dir}, {weight}: escaped");
         assert_eq!(record.losses.len(), 3, "{dir}, {weight}");
         for &(loss, w) in &record.losses {
@@ -172,7 +177,7 @@ fn side_by_side_walks_and_ends_every_photon_once() {
 
 #[test]
 fn next_event_estimation_passes_losses_on() {
-    let facet = Fixed(Branch { dir: DVec3::new(f64::NAN, 0.0, 1.0), weight: [1.0], crosses: false });
+    let facet = always(Branch { dir: DVec3::new(f64::NAN, 0.0, 1.0), weight: [1.0], crosses: false });
     let (mut sink, mut rng, mut stack) = (Record::default(), Pcg64Mcg::new(83), Vec::new());
     let mut nee_rng = Pcg64Mcg::new(84);
     let mut nee = NextEvent {
@@ -235,31 +240,16 @@ fn the_interactions_of_split_photons_are_their_hits() {
     assert_eq!(interactions, record.hits);
 }
 
-/// A facet that always offers the same two branches.
-struct FixedPair(Branch<1>, Branch<1>);
-
-impl Facet<1> for FixedPair {
-    fn interact<R: Rng + ?Sized>(&self, _w: DVec3, _m: DVec3, _side: Side, _rng: &mut R) -> Interaction<1> {
-        Interaction::Two(self.0, self.1)
-    }
-    fn may_split(&self) -> bool {
-        true
-    }
-    fn phase<N: Ndf, R: Rng + ?Sized>(&self, _: &N, _: DVec3, _: DVec3, _: Side, _: bool, _: &mut R) -> [f64; 1] {
-        unreachable!("not used by the walk")
-    }
-}
-
 #[test]
 fn a_random_choice_is_proportional_to_the_weight_carried() {
     // §4.6: branch a (factor 0.3) is chosen with probability 0.3 / 0.5 and b (0.2) with
     // 0.2 / 0.5, each divided by its probability: whichever is chosen, the path carries 0.5
     // of its weight on, so an escape of order k carries exactly 0.5^k (no roulette here).
     // a heads down (always hits again), b up at 80 deg (often hits again).
-    let pair = FixedPair(
+    let pair = Offers(Interaction::Two(
         Branch { dir: DVec3::new(0.3, 0.0, -1.0).normalize(), weight: [0.3], crosses: false },
         Branch { dir: DVec3::new(-5.7, 0.0, 1.0).normalize(), weight: [0.2], crosses: false },
-    );
+    ));
     let (record, _) = trace(&pair, &EnergyPolicy { split: false, threshold: 0.0 }, 5_000);
     assert!(record.escapes.iter().any(|&(k, _)| k >= 3), "no high orders reached");
     for &(k, w) in &record.escapes {
