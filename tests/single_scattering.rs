@@ -16,8 +16,8 @@ mod common;
 
 use common::{albedo, mono, simulate, two_sided_z, weighted_bins};
 use smithwalk::analysis::models::single_scattering_bins;
-use smithwalk::analysis::stats::{chi_square, sidak};
-use smithwalk::engine::detector::Hemisphere;
+use smithwalk::analysis::stats::{ChiSquare, chi_square, sidak};
+use smithwalk::engine::detector::{Detector, Hemisphere};
 
 struct HistogramCase {
     surface: &'static str,
@@ -72,6 +72,24 @@ const CASES: [HistogramCase; 6] = [
     },
 ];
 
+/// Beside a chi-square `test` of the order-1 histogram on `hemisphere` against `expected`: it
+/// kept at least 16 cells (a lobe wrongly expected to be zero almost everywhere pools into one
+/// untested cell), and the order-1 albedo matches the bins' sum by a z test at `level`.
+fn assert_cells_and_albedo(
+    d: &Detector<1>,
+    hemisphere: Hemisphere,
+    test: &ChiSquare,
+    expected: &[f64],
+    level: f64,
+    label: &str,
+) {
+    assert!(test.dof >= 16, "{label}: only {} cells tested", test.dof);
+    let (e1, se) = albedo(d, 1, hemisphere);
+    let total: f64 = expected.iter().sum();
+    println!("{label}: E1 {e1:.5} +- {se:.5}, single scattering {total:.5}");
+    assert!((e1 - total).abs() < two_sided_z(level) * se, "{label}: E1 = {e1} +- {se}, single scattering {total}");
+}
+
 #[test]
 fn order_one_histograms_match_single_scattering() {
     let tests: usize = CASES.iter().map(|c| c.hemispheres.len()).sum();
@@ -90,15 +108,7 @@ fn order_one_histograms_match_single_scattering() {
         for &h in c.hemispheres {
             let expected = single_scattering_bins(&sim.cases[0], &d.grid, h, 1e-10).expect("closed form applies");
             let test = chi_square(&weighted_bins(d, 1, h), &expected, d.tallies.photons, 5.0);
-            // A lobe expected to be zero almost everywhere pools into one untested cell: the
-            // test must keep cells, and the order-1 albedo must match the bins' sum.
-            let (e1, se) = albedo(d, 1, h);
-            let total: f64 = expected.iter().sum();
-            assert!(test.dof >= 16, "case {i} {h:?}: only {} cells tested", test.dof);
-            assert!(
-                (e1 - total).abs() < two_sided_z(level) * se,
-                "case {i} {h:?}: E1 = {e1} +- {se}, single scattering {total}"
-            );
+            assert_cells_and_albedo(d, h, &test, &expected, level, &format!("case {i} {h:?}"));
             assert!(
                 test.p_value > level,
                 "case {i} ({} / {} at {} deg) {h:?}: order-1 histogram rejected\n{}",
@@ -197,14 +207,8 @@ fn order_one_of_scattering_facets_matches_single_scattering() {
             "{material} {alpha} at {theta} deg: chi2 {:.1}, dof {}, p {:.3e}",
             test.statistic, test.dof, test.p_value
         );
-        assert!(test.dof >= 16, "{material} {alpha} at {theta} deg: only {} cells tested", test.dof);
-        let (e1, se) = albedo(d, 1, Hemisphere::R);
-        let total: f64 = expected.iter().sum();
-        println!("{material} {alpha} at {theta} deg: E1 {e1:.5} +- {se:.5}, single scattering {total:.5}");
-        assert!(
-            (e1 - total).abs() < two_sided_z(level) * se,
-            "{material} {alpha} at {theta} deg: E1 = {e1} +- {se}, single scattering {total}"
-        );
+        let label = format!("{material} {alpha} at {theta} deg");
+        assert_cells_and_albedo(d, Hemisphere::R, &test, &expected, level, &label);
         assert!(test.p_value > level, "{material} {alpha} at {theta} deg: order 1 rejected\n{}", test.worst_cells(10));
     }
 }
