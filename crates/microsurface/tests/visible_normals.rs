@@ -24,7 +24,7 @@ use std::f64::consts::TAU;
 use microsurface::DVec3;
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, visible_slope_beckmann};
 use microsurface::normals::Normals;
-use numerics::quadrature::integrate;
+use numerics::quadrature::{integrate, integrate_2d_nested};
 use numerics::stats::{WeightedBin, chi_square, sidak};
 use rand_pcg::Pcg64Mcg;
 
@@ -51,13 +51,13 @@ fn expected(density: impl Fn(DVec3) -> f64) -> Vec<f64> {
             let p = (ip as f64 * TAU / PHI_BINS as f64, (ip + 1) as f64 * TAU / PHI_BINS as f64);
             // Azimuth outside, cosine inside, so that each azimuth's sine and cosine are
             // computed once for its whole inner integral.
-            let over_u = |phi: f64, su: (f64, f64), tol: f64| {
+            let density = &density;
+            let over_u = |phi: f64| {
                 let (sin_phi, cos_phi) = phi.sin_cos();
-                let f = |u: f64| {
+                move |u: f64| {
                     let s = (1.0 - u * u).max(0.0).sqrt();
                     density(DVec3::new(s * cos_phi, s * sin_phi, u))
-                };
-                integrate(f, su.0, su.1, tol).0
+                }
             };
             // 4 x 4 sub-panels per bin, so that the adaptive rule sees narrow features. An
             // absolute tolerance of 1e-8 a sub-panel bounds a bin's error by 1.6e-7, 0.03 of a
@@ -69,9 +69,7 @@ fn expected(density: impl Fn(DVec3) -> f64) -> Vec<f64> {
                 for b in 0..4 {
                     let su = (u.0 + (u.1 - u.0) * a as f64 / 4.0, u.0 + (u.1 - u.0) * (a + 1) as f64 / 4.0);
                     let sp = (p.0 + (p.1 - p.0) * b as f64 / 4.0, p.0 + (p.1 - p.0) * (b + 1) as f64 / 4.0);
-                    // The inner tolerance scaled to the outer interval, as `integrate_2d` does.
-                    let inner = 1e-8 / (sp.1 - sp.0) * 0.1;
-                    sum += integrate(|phi| over_u(phi, su, inner), sp.0, sp.1, 1e-8).0;
+                    sum += integrate_2d_nested(over_u, sp, su, 1e-8).0;
                 }
             }
             out.push(sum);

@@ -95,8 +95,20 @@ pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, abs_tol: f64) -> (f64, 
 /// `∫_{x0}^{x1} ∫_{y0}^{y1} f(x, y) dy dx` by nested adaptive quadrature; the inner integrals
 /// get a tolerance scaled to the outer interval.
 pub fn integrate_2d(f: impl Fn(f64, f64) -> f64, x: (f64, f64), y: (f64, f64), abs_tol: f64) -> (f64, f64) {
+    let f = &f;
+    integrate_2d_nested(|xv| move |yv| f(xv, yv), x, y, abs_tol)
+}
+
+/// [`integrate_2d`] with the integrand given per outer abscissa: `inner_at(x)` is `y -> f(x, y)`,
+/// so what depends on `x` alone is computed once for its whole inner integral.
+pub fn integrate_2d_nested<G: Fn(f64) -> f64>(
+    inner_at: impl Fn(f64) -> G,
+    x: (f64, f64),
+    y: (f64, f64),
+    abs_tol: f64,
+) -> (f64, f64) {
     let inner_tol = abs_tol / (x.1 - x.0).abs().max(1e-300) * 0.1;
-    integrate(|xv| integrate(|yv| f(xv, yv), y.0, y.1, inner_tol).0, x.0, x.1, abs_tol)
+    integrate(|xv| integrate(inner_at(xv), y.0, y.1, inner_tol).0, x.0, x.1, abs_tol)
 }
 
 /// Kronrod abscissae of the 7-point rule that extends the 3-point Gauss rule, on [-1, 1].
