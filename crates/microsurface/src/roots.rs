@@ -71,4 +71,23 @@ mod tests {
             assert!((x - root).abs() <= 4e-15 && calls <= 12, "x0 {x0}: {x} after {calls} calls");
         }
     }
+
+    #[test]
+    fn the_last_step_is_taken() {
+        // x - 1/2 with a derivative twice too large: each step halves the error, exactly in
+        // binary, so the search ends on a step of 2^-50 (the first below 1.5e-15) with the error
+        // 2^-49 before it. Taking that step leaves 2^-50 = 8.9e-16, within the tolerance;
+        // undoing it would leave 3 x 2^-50.
+        let (x, _) = solve(|x| x - 0.5, |_| 2.0, 0.0, 1.0, 1.0);
+        assert!((x - 0.5).abs() <= 1.5e-15, "{x}");
+    }
+
+    #[test]
+    fn a_root_at_a_jump_is_bracketed_to_tolerance() {
+        // A CDF with an atom: f jumps from -0.1 to 0.1 at 0.3, so no Newton step is ever small
+        // and only the bracket can end the search: about 50 halvings of [0, 1], not the 200
+        // evaluations of the iteration limit.
+        let (x, calls) = solve(|x| if x < 0.3 { x - 0.4 } else { x - 0.2 }, |_| 1.0, 0.0, 1.0, 0.9);
+        assert!((x - 0.3).abs() <= 2e-15 && calls <= 60, "{x} after {calls} calls");
+    }
 }

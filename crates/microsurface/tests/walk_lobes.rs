@@ -491,4 +491,9 @@ fn single_scattering_has_no_lobe_on_the_wrong_side() {
     for (wi, wo) in [(up, dir(40.0, 180.0)), (down, down), (down, up)] {
         assert_eq!(single::transmission(&ndf, wi, wo, 1.5, f), 0.0, "transmission {wi} -> {wo}");
     }
+    // Light from inside (eta = 1/1.5) at 80 deg and a detector at 80 deg opposite, both above:
+    // there the refraction half vector exists (wi·wo = -0.94 < -eta, and wi·h = 0.85 is below
+    // the critical angle), so only the horizon test keeps the lobe off the light's side.
+    let inside = |c: f64| fresnel::dielectric(1.0 / 1.5, c);
+    assert_eq!(single::transmission(&ndf, dir(80.0, 0.0), dir(80.0, 180.0), 1.0 / 1.5, inside), 0.0);
 }
