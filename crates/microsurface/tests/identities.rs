@@ -108,6 +108,24 @@ fn lambda_at_the_poles_and_the_horizon() {
 }
 
 #[test]
+fn ggx_lambda_keeps_its_relative_precision_near_the_zenith() {
+    // Near the zenith Lambda = (sqrt(1 + a^2) - 1) / 2 with a = alpha tan(theta) (§1.4) is the
+    // difference of two nearly equal numbers; its series a^2/4 - a^4/16 + a^6/32 (the next
+    // term, 5 a^8 / 256, is below 1e-17 relative for a^2 <= 4e-6) is the reference. The
+    // cancelling form would lose all digits at a^2 = 1e-14.
+    for alpha in [0.1, 0.5, 2.0] {
+        for theta in [1e-7, 1e-5, 1e-3] {
+            let ggx = Ggx(Roughness::isotropic(alpha));
+            let w = DVec3::new(f64::sin(theta), 0.0, f64::cos(theta));
+            let a2 = (alpha * f64::tan(theta)).powi(2);
+            let series = a2 / 4.0 - a2 * a2 / 16.0 + a2 * a2 * a2 / 32.0;
+            let lambda = ggx.lambda(w);
+            assert!((lambda / series - 1.0).abs() < 1e-12, "alpha {alpha}, theta {theta}: {lambda} vs {series}");
+        }
+    }
+}
+
+#[test]
 fn fresnel_reference_values() {
     // §4.2 [verified] values of the exact conductor Fresnel.
     assert!((fresnel::conductor(0.2, 3.0, 1.0) - 0.923372).abs() < 1e-6);
