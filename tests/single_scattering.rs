@@ -229,3 +229,24 @@ fn lambertian_single_scattering_albedo_matches_the_formula_values() {
         assert!((e1 - reference).abs() < 2e-3, "alpha {alpha} theta {theta}: E1 = {e1}, formula {reference}");
     }
 }
+
+#[test]
+fn single_scattering_is_offered_only_where_it_is_order_one_of_the_walk() {
+    // §5 is the order-1 output of the walk with the true Smith Lambda and visible normals, light
+    // from outside. Each case below differs from such a case in one of the three, and then no
+    // lobe may be offered: `compare` would judge the walk against the wrong oracle.
+    let grid = smithwalk::engine::detector::Grid { cos_bins: 2, phi_bins: 4 };
+    let case = |surface: &str, incident: &str| {
+        let toml = format!(
+            "paths = 10\n[surface]\nalpha = 0.5\n{surface}\n[material]\nkind = \"dielectric\"\neta = 1.5\n[incident]\ntheta_deg = 30\n{incident}\n"
+        );
+        smithwalk::setup::cases::expand(&smithwalk::setup::config::Config::parse(&toml).unwrap())[0].clone()
+    };
+    assert!(single_scattering_bins(&case("", ""), &grid, Hemisphere::R, 1e-6).is_some());
+    for (surface, incident) in
+        [("smith = \"symmetric\"", ""), ("normals = \"hammon-rejection\"", ""), ("", "side = \"inside\"")]
+    {
+        let lobe = single_scattering_bins(&case(surface, incident), &grid, Hemisphere::R, 1e-6);
+        assert!(lobe.is_none(), "offered for {surface}{incident}");
+    }
+}
