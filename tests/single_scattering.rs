@@ -11,6 +11,9 @@
 //! * Albedo: at 10^7 photons the order-1 albedo of the GGX conductor with F = 1 is compared
 //!   with the quadrature values of docs/theory.md §9.4 (independent scripts; 1 - ln 2 in closed
 //!   form at alpha 1, normal incidence), within 4 standard errors (SE about 1.5e-4).
+//! * The model itself: on nearly smooth surfaces its bins' sum against the order-1 albedo
+//!   integrated over the visible normals instead of the outgoing directions, and it is offered
+//!   only for the walk it describes (true Smith Lambda, visible normals, light from outside).
 
 mod common;
 
