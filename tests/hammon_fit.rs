@@ -75,3 +75,22 @@ fn the_fit_is_the_slides_formula_at_fixed_directions() {
     assert_eq!(hammon_fit_lobe(0.5, 0.04, 0.8, dir(100.0, 0.0), dir(30.0, 0.0), HammonFitPart::All), 0.0);
     assert_eq!(hammon_fit_lobe(0.5, 0.04, 0.8, dir(30.0, 0.0), dir(100.0, 0.0), HammonFitPart::All), 0.0);
 }
+
+#[test]
+fn the_fit_is_offered_only_for_isotropic_ggx_lit_from_outside() {
+    // The slides fit isotropic GGX with light from outside; for any other case `compare` must
+    // show no fit rather than the fit of another surface. Each case differs from one that is
+    // offered in one field (a Hammon facet lit from inside is refused by the config, so that
+    // case is built by hand).
+    let grid = Grid { cos_bins: 2, phi_bins: 4 };
+    let (isotropic, _) = case(0.5, 0.04, 0.8, 30.0);
+    let beckmann =
+        smithwalk::setup::cases::Case { ndf: smithwalk::setup::config::NdfKind::Beckmann, ..isotropic.clone() };
+    let anisotropic = smithwalk::setup::cases::Case { alpha_y: 0.3, ..isotropic.clone() };
+    let inside =
+        smithwalk::setup::cases::Case { side: smithwalk::setup::config::IncidentSide::Inside, ..isotropic.clone() };
+    assert!(hammon_fit_bins(&isotropic, &grid, HammonFitPart::All, 1e-6).is_some());
+    for (label, c) in [("beckmann", beckmann), ("anisotropic", anisotropic), ("inside", inside)] {
+        assert!(hammon_fit_bins(&c, &grid, HammonFitPart::All, 1e-6).is_none(), "offered for {label}");
+    }
+}
