@@ -108,6 +108,31 @@ fn lambda_at_the_poles_and_the_horizon() {
 }
 
 #[test]
+fn projected_area_at_the_horizon() {
+    // A(w) = (1 + Lambda(w)) cos(theta) tends to alpha_w / 2 (GGX) and alpha_w / (2 sqrt(pi))
+    // (Beckmann) as w reaches the horizon, where Lambda ~ 1 / (2a) and e^{-a^2} / (2a sqrt(pi))
+    // with a = cot(theta) / alpha_w (§1.4), alpha_w = sqrt(alpha_x^2 cos^2 phi + alpha_y^2
+    // sin^2 phi); at the horizon itself, from either side (z = +0 and -0), that limit, not the
+    // 0 x inf of the formula, and 1e-6 deg away nearly the same.
+    let r = Roughness { x: 0.5, y: 0.2 };
+    let phi = 30f64.to_radians();
+    let alpha_w = (r.x * r.x * phi.cos().powi(2) + r.y * r.y * phi.sin().powi(2)).sqrt();
+    let (ggx, beck) = (Ggx(r), Beckmann(r));
+    for z in [0.0, -0.0] {
+        let w = DVec3::new(phi.cos(), phi.sin(), z);
+        for (name, area, limit) in [
+            ("ggx", ggx.projected_area(w), alpha_w / 2.0),
+            ("beckmann", beck.projected_area(w), alpha_w / (2.0 * PI.sqrt())),
+        ] {
+            assert!((area / limit - 1.0).abs() < 1e-12, "{name}, z = {z}: {area} vs {limit}");
+        }
+    }
+    let near = dir(90.0 - 1e-6, 30.0);
+    assert!((ggx.projected_area(near) / (alpha_w / 2.0) - 1.0).abs() < 1e-6);
+    assert!((beck.projected_area(near) / (alpha_w / (2.0 * PI.sqrt())) - 1.0).abs() < 1e-6);
+}
+
+#[test]
 fn ggx_lambda_keeps_its_relative_precision_near_the_zenith() {
     // Near the zenith Lambda = (sqrt(1 + a^2) - 1) / 2 with a = alpha tan(theta) (§1.4) is the
     // difference of two nearly equal numbers; its series a^2/4 - a^4/16 + a^6/32 (the next

@@ -158,11 +158,25 @@ fn visible_normals_match_the_visible_normal_density() {
     }
 }
 
+#[test]
+fn visible_normals_at_normal_incidence() {
+    // Light straight down: the stretched direction is the pole, where Beckmann's sampler has
+    // no view-plane slope (`mu = cot theta'` is infinite) and draws both slopes from the
+    // normal law instead (§3.1); GGX's cap is the whole upper sphere.
+    let level = sidak(0.01, FAMILY);
+    for (i, (ax, ay)) in ROUGHNESSES.into_iter().enumerate() {
+        let r = Roughness { x: ax, y: ay };
+        let seed = 1000 + 2 * i as u64;
+        check(&Ggx(r), Normals::Visible, DVec3::Z, level, seed, &format!("ggx alpha=({ax},{ay}) w=z"));
+        check(&Beckmann(r), Normals::Visible, DVec3::Z, level, seed + 1, &format!("beckmann alpha=({ax},{ay}) w=z"));
+    }
+}
+
 const HAMMON_TESTS: usize = 6;
 
 /// The chi-square tests of this file at the family level 0.01: the cases of `all_cases` (2
-/// NDFs), Hammon's, the slope tests and the lanes.
-const FAMILY: usize = 2 * ROUGHNESSES.len() * DIRECTIONS.len() + HAMMON_TESTS + SLOPE_MUS.len() + LANE_TESTS;
+/// NDFs) and of normal incidence, Hammon's, the slope tests and the lanes.
+const FAMILY: usize = 2 * ROUGHNESSES.len() * (DIRECTIONS.len() + 1) + HAMMON_TESTS + SLOPE_MUS.len() + LANE_TESTS;
 
 #[test]
 fn hammon_rejection_samples_the_unweighted_restricted_ndf() {
