@@ -172,7 +172,7 @@ fn visible_normals_at_normal_incidence() {
     }
 }
 
-const HAMMON_TESTS: usize = 6;
+const HAMMON_TESTS: usize = 8;
 
 /// The chi-square tests of this file at the family level 0.01: the cases of `all_cases` (2
 /// NDFs) and of normal incidence, Hammon's, the slope tests and the lanes.
@@ -203,6 +203,12 @@ fn hammon_rejection_samples_the_unweighted_restricted_ndf() {
             100 + i as u64,
             &format!("hammon {ax},{ay} {t},{p}"),
         );
+    }
+    // Beckmann, with its own slope-radius inversion and CDF bound: downward, and upward where
+    // X1 is shrunk (cot^2 = 0.53 in the stretched frame, as above).
+    for (i, (t, p)) in [(40.0, 70.0), (110.0, 200.0)].into_iter().enumerate() {
+        let ndf = Beckmann(Roughness::isotropic(0.5));
+        check(&ndf, Normals::HammonRejection, dir(t, p), level, 110 + i as u64, &format!("hammon beckmann {t},{p}"));
     }
 }
 
