@@ -17,10 +17,10 @@ mod common;
 use common::dir;
 use smithwalk::analysis::models::{HammonFitPart, hammon_fit_bins, hammon_fit_lobe};
 use smithwalk::engine::detector::Grid;
-use smithwalk::setup::cases::expand;
-use smithwalk::setup::config::Config;
+use smithwalk::setup::cases::{Case, expand};
+use smithwalk::setup::config::{Config, IncidentSide, NdfKind};
 
-fn case(alpha: f64, f0: f64, albedo: f64, theta: f64) -> (smithwalk::setup::cases::Case, String) {
+fn case(alpha: f64, f0: f64, albedo: f64, theta: f64) -> (Case, String) {
     let toml = format!(
         "paths = 1_000_000\nseed = 21\n[surface]\nalpha = {alpha}\n[material]\nkind = \"hammon\"\nf0 = {f0}\nalbedo = {albedo}\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 16\nphi_bins = 32\nmax_order = 3\n"
     );
@@ -84,11 +84,9 @@ fn the_fit_is_offered_only_for_isotropic_ggx_lit_from_outside() {
     // case is built by hand).
     let grid = Grid { cos_bins: 2, phi_bins: 4 };
     let (isotropic, _) = case(0.5, 0.04, 0.8, 30.0);
-    let beckmann =
-        smithwalk::setup::cases::Case { ndf: smithwalk::setup::config::NdfKind::Beckmann, ..isotropic.clone() };
-    let anisotropic = smithwalk::setup::cases::Case { alpha_y: 0.3, ..isotropic.clone() };
-    let inside =
-        smithwalk::setup::cases::Case { side: smithwalk::setup::config::IncidentSide::Inside, ..isotropic.clone() };
+    let beckmann = Case { ndf: NdfKind::Beckmann, ..isotropic.clone() };
+    let anisotropic = Case { alpha_y: 0.3, ..isotropic.clone() };
+    let inside = Case { side: IncidentSide::Inside, ..isotropic.clone() };
     assert!(hammon_fit_bins(&isotropic, &grid, HammonFitPart::All, 1e-6).is_some());
     for (label, c) in [("beckmann", beckmann), ("anisotropic", anisotropic), ("inside", inside)] {
         assert!(hammon_fit_bins(&c, &grid, HammonFitPart::All, 1e-6).is_none(), "offered for {label}");

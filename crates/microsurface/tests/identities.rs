@@ -118,18 +118,18 @@ fn projected_area_at_the_horizon() {
     let phi = 30f64.to_radians();
     let alpha_w = (r.x * r.x * phi.cos().powi(2) + r.y * r.y * phi.sin().powi(2)).sqrt();
     let (ggx, beck) = (Ggx(r), Beckmann(r));
+    let (ggx_limit, beck_limit) = (alpha_w / 2.0, alpha_w / (2.0 * PI.sqrt()));
     for z in [0.0, -0.0] {
         let w = DVec3::new(phi.cos(), phi.sin(), z);
-        for (name, area, limit) in [
-            ("ggx", ggx.projected_area(w), alpha_w / 2.0),
-            ("beckmann", beck.projected_area(w), alpha_w / (2.0 * PI.sqrt())),
-        ] {
+        for (name, area, limit) in
+            [("ggx", ggx.projected_area(w), ggx_limit), ("beckmann", beck.projected_area(w), beck_limit)]
+        {
             assert!((area / limit - 1.0).abs() < 1e-12, "{name}, z = {z}: {area} vs {limit}");
         }
     }
     let near = dir(90.0 - 1e-6, 30.0);
-    assert!((ggx.projected_area(near) / (alpha_w / 2.0) - 1.0).abs() < 1e-6);
-    assert!((beck.projected_area(near) / (alpha_w / (2.0 * PI.sqrt())) - 1.0).abs() < 1e-6);
+    assert!((ggx.projected_area(near) / ggx_limit - 1.0).abs() < 1e-6);
+    assert!((beck.projected_area(near) / beck_limit - 1.0).abs() < 1e-6);
 }
 
 #[test]
