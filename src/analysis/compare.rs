@@ -145,8 +145,8 @@ struct ModelLobe {
 #[derive(Default)]
 struct Predictions {
     lobes: Vec<ModelLobe>,
-    /// Bins stopped at the evaluation bound, and the largest error estimate there in units of
-    /// the bin's tolerance.
+    /// Bin integrals stopped at the evaluation bound, and the largest error estimate there in
+    /// units of the bin's tolerance.
     capped: usize,
     worst_capped: f64,
     /// Why the model was not compared, if it was not.
@@ -623,7 +623,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
                 model,
                 format!(
                     "the quadrature stopped at its evaluation bound ({MAX_BIN_EVALUATIONS} per bin, \
-                     {MAX_EXIT_BIN_EVALUATIONS} for exit lobes) in {} bins; largest error estimate there: {:.2} \
+                     {MAX_EXIT_BIN_EVALUATIONS} for the diffuse exits of diffuse and Hammon facets) in {} bin integrals; largest error estimate there: {:.2} \
                      standard errors of the bin",
                     predictions.capped,
                     predictions.worst_capped * QUADRATURE_FRACTION
