@@ -520,7 +520,7 @@ pub fn compensated_bins<const C: usize>(
     let alpha = case.alpha_x;
     let albedo = cache.get(case.ndf, alpha, Fresnel::One).clone();
     let wi = case.incident_direction();
-    let peak = specular_peak(case, Hemisphere::R, 1.0);
+    let peak = specular_peak(case, Hemisphere::R);
     let rule = (peak, tolerance, MAX_BIN_EVALUATIONS);
     let mut done: Vec<(Fresnel, LobeIntegrals)> = Vec::new();
     Some(channels.map(|f| {

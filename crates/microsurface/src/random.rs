@@ -12,9 +12,10 @@ const TWO_POW_M53: f64 = 1.0 / (1u64 << 53) as f64;
 const BELOW_ONE: f64 = 1.0 - TWO_POW_M53;
 
 /// A uniform variate in the open interval (0, 1): `(k + 1/2) 2^-53` for the draw's top 53 bits
-/// `k`, rounded to the nearest double. Above 1/2, where doubles are 2^-53 apart, the ties go
-/// to even, and the last, `1 - 2^-54`, would round to 1: it is taken as `1 - 2^-53` (a
-/// Lambertian exit would otherwise leave along the horizon).
+/// `k`, rounded to the nearest double. Above 1/2, where doubles are 2^-53 apart, these are
+/// ties that go to even, so the values there lie on a grid of 2^-52, two draws each; the last,
+/// `1 - 2^-54`, would round to 1 and is taken as `1 - 2^-53` (a Lambertian exit would
+/// otherwise leave along the horizon).
 #[inline]
 pub fn open01<R: Rng + ?Sized>(rng: &mut R) -> f64 {
     (((rng.next_u64() >> 11) as f64 + 0.5) * TWO_POW_M53).min(BELOW_ONE)
@@ -143,7 +144,7 @@ mod tests {
         assert_eq!(open01(&mut Fixed(0)), 0.5 * TWO_POW_M53);
     }
 
-    /// `open01` of the largest draw is below 1, so `ln(1 - u)` and `sqrt(1 - u)` stay positive;
+    /// `open01` of the largest draw is below 1, so `ln(1 - u)` stays finite and `sqrt(1 - u)` positive;
     /// the draw below it keeps its own value, `1 - 3 2^-54` rounded to even, `1 - 2^-52`.
     #[test]
     fn open01_of_the_largest_draw_is_below_one() {
