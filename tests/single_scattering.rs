@@ -265,17 +265,16 @@ fn single_scattering_is_offered_only_where_it_is_order_one_of_the_walk() {
     }
 }
 
-/// What a facet of normal `m` sends into `hemisphere` at order 1, per unit of visible-normal
-/// density: its Fresnel weight `w(m)` (1 for the conductor with F = 1) times `G2(wi, wo) /
-/// G1(wi)`, where `wo` is the mirror or refracted direction (§5).
-fn order_one_escape<N: Ndf>(ndf: &N, wi: DVec3, m: DVec3, eta: Option<f64>, hemisphere: Hemisphere) -> f64 {
-    let g1 = 1.0 / (1.0 + ndf.lambda(wi));
+/// What a facet of normal `m` sends into `hemisphere` at order 1, before the division by
+/// `G1(wi)`: its Fresnel weight `w(m)` (1 for the conductor with F = 1) times `G2(wi, wo)`,
+/// where `wo` is the mirror or refracted direction (§5).
+fn order_one_weight<N: Ndf>(ndf: &N, wi: DVec3, m: DVec3, eta: Option<f64>, hemisphere: Hemisphere) -> f64 {
     let c = wi.dot(m);
     let f = eta.map_or(1.0, |eta| fresnel::dielectric(eta, c));
     match (hemisphere, eta) {
         (Hemisphere::R, _) => {
             let wo = 2.0 * c * m - wi;
-            if wo.z > 0.0 { f * single::g2_reflection(ndf, wi, wo) / g1 } else { 0.0 }
+            if wo.z > 0.0 { f * single::g2_reflection(ndf, wi, wo) } else { 0.0 }
         }
         (Hemisphere::T, Some(eta)) => {
             let ct2 = 1.0 - (1.0 - c * c) / (eta * eta);
@@ -283,7 +282,7 @@ fn order_one_escape<N: Ndf>(ndf: &N, wi: DVec3, m: DVec3, eta: Option<f64>, hemi
                 return 0.0;
             }
             let wo = (c / eta - ct2.sqrt()) * m - wi / eta;
-            if wo.z < 0.0 { (1.0 - f) * single::g2_transmission(ndf, wi, wo) / g1 } else { 0.0 }
+            if wo.z < 0.0 { (1.0 - f) * single::g2_transmission(ndf, wi, wo) } else { 0.0 }
         }
         (Hemisphere::T, None) => 0.0,
     }
@@ -291,8 +290,9 @@ fn order_one_escape<N: Ndf>(ndf: &N, wi: DVec3, m: DVec3, eta: Option<f64>, hemi
 
 /// The order-1 albedo `E1 = ∫ D_wi(m) w(m) G2(wi, wo) / G1(wi) dm` (§5) of a GGX surface, by
 /// quadrature over the visible normals rather than over `wo`: the normals are parametrised by
-/// the spherical-cap map of §3.2 (`u` uniform on [0, 1], `phi` on [0, 2 pi), density 1 / 2 pi).
-/// A lobe as narrow as alpha in `wo` is then a smooth integrand of `(u, phi)`.
+/// the spherical-cap map of §3.2 (`u` uniform on [0, 1], `phi` on [0, 2 pi), density 1 / 2 pi),
+/// and `1 / G1(wi)` leaves the integral. A lobe as narrow as alpha in `wo` is then a smooth
+/// integrand of `(u, phi)`.
 fn ggx_order_one_albedo_over_the_normals(alpha: f64, wi: DVec3, eta: Option<f64>, hemisphere: Hemisphere) -> f64 {
     let roughness = Roughness::isotropic(alpha);
     let ndf = Ggx(roughness);
@@ -303,22 +303,21 @@ fn ggx_order_one_albedo_over_the_normals(alpha: f64, wi: DVec3, eta: Option<f64>
         let h = DVec3::new(s * phi.cos(), s * phi.sin(), z) + ws;
         roughness.unstretch_normal(DVec3::new(h.x, h.y, h.z.max(0.0)))
     };
-    let escape = |u, phi| order_one_escape(&ndf, wi, normal(u, phi), eta, hemisphere);
-    integrate_2d(escape, (0.0, 1.0), (0.0, TAU), 1e-9).0 / TAU
+    let weight = |u, phi| order_one_weight(&ndf, wi, normal(u, phi), eta, hemisphere);
+    (1.0 + ndf.lambda(wi)) * integrate_2d(weight, (0.0, 1.0), (0.0, TAU), 1e-9).0 / TAU
 }
 
 /// The same albedo of a Beckmann surface, by quadrature over the slopes: with `D_wi(m) dm =
 /// G1(wi) max(0, wi . m) P22(s) ds / (cos theta_i cos theta_m)` (§3.1, and `D cos theta_m dm =
 /// P22 ds`, §1.1) and the isotropic Beckmann slopes `P22(s) = exp(-|s|^2 / alpha^2) / (pi
 /// alpha^2)`, the radius `|s| = alpha sqrt(-ln(1 - t))` makes `t` uniform on [0, 1] and `phi`
-/// on [0, 2 pi): `E1 = ∫∫ G1 max(0, wi . m) / (cos theta_i cos theta_m) w G2 / G1 dt dphi / 2
-/// pi`. However small alpha is, the integrand varies on a scale of 1 in `t`, with kinks only
+/// on [0, 2 pi): `E1 = ∫∫ max(0, wi . m) / (cos theta_i cos theta_m) w G2 dt dphi / 2 pi`, the
+/// `G1` of `D_wi` cancelling that of `E1`. However small alpha is, the integrand varies on a scale of 1 in `t`, with kinks only
 /// where facets turn away from `wi` or send `wo` below the horizon.
 /// Independent of the bin quadrature, its grading and the reflection and refraction Jacobians;
 /// it shares Lambda, G2 and Fresnel with the model.
 fn beckmann_order_one_albedo_over_the_slopes(alpha: f64, wi: DVec3, eta: Option<f64>, hemisphere: Hemisphere) -> f64 {
     let ndf = Beckmann(Roughness::isotropic(alpha));
-    let g1 = 1.0 / (1.0 + ndf.lambda(wi));
     let integrand = |t: f64, phi: f64| {
         let r = alpha * (-(-t).ln_1p()).sqrt();
         // At grazing incidence the facets turned away from wi start near t = 1, where the
@@ -327,8 +326,8 @@ fn beckmann_order_one_albedo_over_the_slopes(alpha: f64, wi: DVec3, eta: Option<
             return 0.0;
         }
         let m = DVec3::new(-r * phi.cos(), -r * phi.sin(), 1.0).normalize();
-        let visible = g1 * wi.dot(m).max(0.0) / (wi.z * m.z);
-        if visible == 0.0 { 0.0 } else { visible * order_one_escape(&ndf, wi, m, eta, hemisphere) }
+        let projected = wi.dot(m).max(0.0) / (wi.z * m.z);
+        if projected == 0.0 { 0.0 } else { projected * order_one_weight(&ndf, wi, m, eta, hemisphere) }
     };
     integrate_2d(integrand, (0.0, 1.0), (0.0, TAU), 1e-9).0 / TAU
 }
@@ -356,11 +355,11 @@ fn narrow_specular_lobes_are_integrated_where_they_peak() {
                 "paths = 10\n[surface]\nndf = \"{ndf}\"\nalpha = {alpha}\n[material]\n{material}\n[incident]\ntheta_deg = {theta}\nphi_deg = 20\n"
             );
             let case = case_of(&toml);
+            let wi = case.incident_direction();
             let hemispheres: &[Hemisphere] =
                 if eta.is_some() { &[Hemisphere::R, Hemisphere::T] } else { &[Hemisphere::R] };
             for &h in hemispheres {
                 let bins: f64 = single_scattering_bins(&case, &grid, h, 1e-9).unwrap().iter().sum();
-                let wi = case.incident_direction();
                 let reference = match ndf {
                     "ggx" => ggx_order_one_albedo_over_the_normals(alpha, wi, eta, h),
                     _ => beckmann_order_one_albedo_over_the_slopes(alpha, wi, eta, h),
@@ -395,9 +394,10 @@ fn exit_lobes_stopped_at_their_bound_are_within_half_a_standard_error() {
         ));
         let coarse = single_scattering_bins(&case, &grid, Hemisphere::R, 1e-4).unwrap();
         let stderr: Vec<f64> = coarse.iter().map(|e| (e.max(0.0) / photons).sqrt().max(1.0 / photons)).collect();
-        let lobe = single_scattering_lobe(&case, &grid, Hemisphere::R, &|bin| 0.05 * stderr[bin]).unwrap();
+        let tolerance = |bin: usize| 0.05 * stderr[bin];
+        let lobe = single_scattering_lobe(&case, &grid, Hemisphere::R, &tolerance).unwrap();
         let worst = lobe.error.iter().zip(&stderr).map(|(e, s)| e / s).fold(0.0, f64::max);
-        let above = lobe.error.iter().zip(&stderr).filter(|&(e, s)| *e > 0.05 * s).count();
+        let above = lobe.error.iter().enumerate().filter(|&(bin, e)| *e > tolerance(bin)).count();
         println!(
             "{ndf} alpha {alpha} {material}: {} bins stopped at the bound, {above} above their tolerance, worst {worst:.3} standard errors",
             lobe.capped

@@ -249,11 +249,11 @@ fn bins_for<N: Ndf>(
 /// Where a specular lobe peaks in bin coordinates (`|cos theta_o|`, phi from the incident
 /// azimuth) and its width there: the mirror direction in reflection, the direction refracted
 /// by the macro-surface in transmission (with the dielectric's eta; none beyond total internal
-/// reflection), both at phi =
-/// pi. A facet tilt of alpha in the plane of incidence turns the outgoing direction by about 2
-/// alpha, which is `2 alpha sin theta_o + 2 alpha^2` in `|cos theta|`; a tilt across it turns
-/// the reflected direction by `2 alpha cos theta_i` sideways, `2 alpha cos theta_i / sin
-/// theta_o` in phi, which is tiny at grazing incidence. The scales are taken a little smaller.
+/// reflection), both at phi = pi. A facet tilt of alpha in the plane of incidence turns the
+/// outgoing direction by about 2 alpha, which is `2 alpha sin theta_o + 2 alpha^2` in `|cos
+/// theta|`; a tilt across it turns the reflected direction by `2 alpha cos theta_i` sideways,
+/// `2 alpha cos theta_i / sin theta_o` in phi, which is tiny at grazing incidence. The scales
+/// are taken a little smaller.
 pub(crate) fn specular_peak(case: &Case, hemisphere: Hemisphere) -> Option<Peak> {
     let eta = match case.material {
         MaterialConfig::Dielectric { eta, .. } => eta,
