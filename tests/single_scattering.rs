@@ -345,12 +345,13 @@ fn narrow_specular_lobes_are_integrated_where_they_peak() {
     let ggx = [0.003, 0.01].map(|alpha| ("ggx", alpha));
     let beckmann = [1e-4, 0.003].map(|alpha| ("beckmann", alpha));
     for (ndf, alpha) in ggx.into_iter().chain(beckmann) {
-        for (material, eta, theta) in [
-            ("kind = \"conductor\"", None, 30.0),
-            ("kind = \"conductor\"", None, 75.0),
-            ("kind = \"conductor\"", None, 89.0),
-            ("kind = \"dielectric\"\neta = 1.5", Some(1.5), 40.0),
-        ] {
+        // At 60 deg the mirror direction lies on a bin edge (cos 0.5), computed a rounding error
+        // beyond it: Beckmann at alpha 1e-4 lost half its lobe there until the grading reached
+        // across edges. GGX's tails were seen anyway, and its reference takes 20 s there.
+        let edge = if ndf == "beckmann" { &[60.0][..] } else { &[] };
+        let conductor = [0.0, 30.0, 75.0, 89.0].iter().chain(edge).map(|&theta| ("kind = \"conductor\"", None, theta));
+        let dielectric = [0.0, 40.0].map(|theta| ("kind = \"dielectric\"\neta = 1.5", Some(1.5), theta));
+        for (material, eta, theta) in conductor.chain(dielectric) {
             let toml = format!(
                 "paths = 10\n[surface]\nndf = \"{ndf}\"\nalpha = {alpha}\n[material]\n{material}\n[incident]\ntheta_deg = {theta}\nphi_deg = 20\n"
             );

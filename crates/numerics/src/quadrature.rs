@@ -218,13 +218,21 @@ fn cell(f: &impl Fn(f64, f64) -> f64, x: (f64, f64), y: (f64, f64)) -> Cell {
     Cell { x, y, value: kk * area, error: scaled(ex + ey), split_x: ex >= ey }
 }
 
-/// The pieces of `[lo, hi]`: graded geometrically towards `at` when it lies in the interval
-/// (pieces halving towards it on either side until they are no wider than `scale`), else the
-/// interval itself.
+/// How far outside an interval, in units of the peak's scale, a peak still grades it: a
+/// Gaussian tail of that many widths is below e^-256, and a peak on an edge, computed a
+/// rounding error outside it, grades both sides.
+const GRADING_REACH: f64 = 16.0;
+
+/// The pieces of `[lo, hi]`: graded geometrically towards the point nearest to `at` when `at`
+/// lies within [`GRADING_REACH`] scales of the interval (pieces halving towards it on either
+/// side until they are no wider than `scale`), else the interval itself.
 fn graded_axis((lo, hi): (f64, f64), at: f64, scale: f64) -> Vec<(f64, f64)> {
-    if !(lo..=hi).contains(&at) || scale <= 0.0 {
+    let nearest = at.clamp(lo, hi);
+    let near = scale > 0.0 && (at - nearest).abs() <= GRADING_REACH * scale;
+    if !near {
         return vec![(lo, hi)];
     }
+    let at = nearest;
     let mut edges = vec![lo, at, hi];
     for side in [at - lo, hi - at] {
         let mut width = side;
@@ -365,6 +373,21 @@ mod tests {
         let r = cubature(f, (0.0, 1.0), (0.0, 1.0), Some(peak), 1e-6 * exact, 200_000);
         assert!((r.value - exact).abs() < 1e-5 * exact && !r.capped, "{r:?} vs {exact}");
         assert_eq!(cubature(f, (0.0, 1.0), (0.0, 1.0), None, 1e-6 * exact, 200_000).value, 0.0);
+    }
+
+    #[test]
+    fn a_peak_just_outside_the_rectangle_grades_its_edge() {
+        // The same Gaussian centred a rounding error outside the square, at x = 1 + 2^-52 (a
+        // peak on a bin edge, computed on the wrong side): half of it lies inside, pi s^2 / 2.
+        // Ten widths away its tail inside is e^-100 of it and grading must not invent mass.
+        let s = 1e-5;
+        let gaussian = |x0: f64| move |x: f64, y: f64| (-((x - x0).powi(2) + (y - 0.7).powi(2)) / (s * s)).exp();
+        let half = 0.5 * std::f64::consts::PI * s * s;
+        for (x0, expected) in [(1.0 + f64::EPSILON, half), (1.0 + 10.0 * s, 0.0)] {
+            let peak = Peak { at: (x0, 0.7), scale: (s, s) };
+            let r = cubature(gaussian(x0), (0.0, 1.0), (0.0, 1.0), Some(peak), 1e-6 * half, 200_000);
+            assert!((r.value - expected).abs() < 1e-5 * half && !r.capped, "{x0}: {r:?} vs {expected}");
+        }
     }
 
     #[test]
