@@ -7,6 +7,7 @@
 use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
+use microsurface::facet::{reflect, refract};
 use microsurface::fresnel;
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, slope_to_normal};
 use microsurface::single;
@@ -247,44 +248,34 @@ fn bins_for<N: Ndf>(
 }
 
 /// Where a specular lobe peaks in bin coordinates (`|cos theta_o|`, phi from the incident
-/// azimuth) and its width there: the mirror direction in reflection, the direction refracted
-/// by the macro-surface in transmission (with the dielectric's eta; none beyond total internal
-/// reflection), both at phi = pi.
-///
-/// The widths are the first-order response of the outgoing direction to a facet tilt (§5):
-/// a tilt `t` across the plane of incidence moves `wo` sideways by `a t`, with
-/// `a = cos theta_i + cos theta_o` in reflection and `|cos theta_o - cos theta_i / eta|` in
-/// transmission (the laws of reflection and refraction to first order in `t`), which is
-/// `a t / sin theta_o` in phi; a tilt in the plane turns `wo` by `w = a t / cos theta_o`, which
-/// is `w sin theta_o + w^2 / 2` in `|cos theta|` (the second term at normal incidence). With
-/// `t = alpha / 2`, a little below the NDF's half width at half maximum in slope (0.64 alpha
-/// for GGX, 0.83 alpha for Beckmann), the scales are 0.36 to 0.8 of the lobes' measured half
-/// widths (`the_grading_scales_are_the_lobe_widths`).
+/// azimuth) and its width there. The peak is the direction the macro-surface's normal scatters
+/// `wi` into, at phi = pi: the mirror direction in reflection, the direction refracted with
+/// the dielectric's eta in transmission (none beyond total internal reflection). The widths
+/// are how far a facet tilted by `alpha / 2` moves it: in `|cos theta|` when tilted in the
+/// plane of incidence (to the horizon if that facet reflects totally), in phi when tilted
+/// across it (pi if so). `alpha / 2` is a little below the NDF's half width at half maximum in
+/// slope (0.64 alpha for GGX, 0.83 alpha for Beckmann), and the narrower of an anisotropic
+/// surface's two (a finer grading costs cells, not accuracy). Scattered exactly rather than to
+/// first order, the widths need no special case at normal incidence (where `|cos theta|`
+/// moves by `alpha^2 / 2` and phi by pi / 2), at grazing angles or at the critical angle.
+/// They are 0.36 to 0.78 of the lobes' measured half widths
+/// (`the_grading_scales_are_the_lobe_widths`).
 pub(crate) fn specular_peak(case: &Case, hemisphere: Hemisphere) -> Option<Peak> {
     let eta = match case.material {
         MaterialConfig::Dielectric { eta, .. } => eta,
         _ => 1.0,
     };
-    let sin_i = case.theta_i_deg.to_radians().sin();
-    let sin_o = match hemisphere {
-        Hemisphere::R => sin_i,
-        Hemisphere::T => sin_i / eta,
+    let (sin_i, cos_i) = case.theta_i_deg.to_radians().sin_cos();
+    let wi = DVec3::new(sin_i, 0.0, cos_i);
+    let scatter = |m: DVec3| match hemisphere {
+        Hemisphere::R => Some(reflect(wi, m)),
+        Hemisphere::T => refract(wi, m, eta),
     };
-    if sin_o >= 1.0 {
-        return None;
-    }
-    let (cos_i, cos_o) = ((1.0 - sin_i * sin_i).sqrt(), (1.0 - sin_o * sin_o).sqrt());
-    let across = match hemisphere {
-        Hemisphere::R => cos_i + cos_o,
-        Hemisphere::T => (cos_o - cos_i / eta).abs(),
-    };
-    let alpha = case.alpha_x.min(case.alpha_y);
-    let tilt = 0.5 * alpha;
-    let in_plane = tilt * across / cos_o;
-    Some(Peak {
-        at: (cos_o, PI),
-        scale: (in_plane * (sin_o + 0.5 * in_plane), (tilt * across / sin_o.max(alpha)).min(PI)),
-    })
+    let cos_o = scatter(DVec3::Z)?.z.abs();
+    let (sin_t, cos_t) = (0.5 * case.alpha_x.min(case.alpha_y)).sin_cos();
+    let in_plane = scatter(DVec3::new(sin_t, 0.0, cos_t)).map_or(cos_o, |wo| (wo.z.abs() - cos_o).abs());
+    let across = scatter(DVec3::new(0.0, sin_t, cos_t)).map_or(PI, |wo| wo.y.abs().atan2(-wo.x));
+    Some(Peak { at: (cos_o, PI), scale: (in_plane, across) })
 }
 
 /// Integrates a cosine-weighted lobe `wo -> f(wi, wo) |cos theta_o|` over every bin of
@@ -418,20 +409,22 @@ mod tests {
     fn the_grading_scales_are_the_lobe_widths() {
         // The grading towards the peak is only as good as its scales: too wide and a spike falls
         // between the nodes, too narrow and the cells are spent before the refinement starts.
-        // Against the half width at half maximum measured on the lobe itself (along |cos theta|
-        // and along phi through the peak), every scale of these narrow lobes lies within 0.3 to
-        // 1 of it: GGX and Beckmann, alpha 1e-3 and 0.01, conductor, dielectric reflection and
-        // transmission at eta 1.5 and 1.05, 0 to 89 deg (phi from 10 deg: at normal incidence
-        // the lobe is round and phi says nothing).
+        // Against the half width at half maximum measured on the lobe itself (from the value at
+        // the peak, along |cos theta| and along phi through it, the wider side), every scale of
+        // these narrow lobes lies within 0.3 to 1 of it: GGX and Beckmann, alpha 1e-3 and 0.01,
+        // conductor, dielectric reflection and transmission at eta 1.5, 1.05 and 0.67, 0 to 89
+        // deg (at eta 0.67 up to its critical angle, 42 deg; beyond it there is no peak). At
+        // normal incidence the lobe is round: its width in phi is pi.
         let mut ratios = Vec::new();
         for ndf in ["ggx", "beckmann"] {
             for alpha in [1e-3, 0.01] {
-                for (material, hemispheres) in [
-                    ("kind = \"conductor\"", &[Hemisphere::R][..]),
-                    ("kind = \"dielectric\"\neta = 1.5", &[Hemisphere::R, Hemisphere::T][..]),
-                    ("kind = \"dielectric\"\neta = 1.05", &[Hemisphere::T][..]),
+                for (material, eta, hemispheres) in [
+                    ("kind = \"conductor\"", None, &[Hemisphere::R][..]),
+                    ("kind = \"dielectric\"\neta = 1.5", Some(1.5), &[Hemisphere::R, Hemisphere::T][..]),
+                    ("kind = \"dielectric\"\neta = 1.05", Some(1.05), &[Hemisphere::T][..]),
+                    ("kind = \"dielectric\"\neta = 0.67", Some(0.67), &[Hemisphere::T][..]),
                 ] {
-                    for theta in [0.0, 10.0, 30.0, 60.0, 85.0, 89.0] {
+                    for theta in [0.0f64, 10.0, 30.0, 40.0, 60.0, 85.0, 89.0] {
                         let case = expand(
                             &Config::parse(&format!(
                                 "paths = 10\n[surface]\nndf = \"{ndf}\"\nalpha = {alpha}\n[material]\n{material}\n[incident]\ntheta_deg = {theta}\nphi_deg = 20\n"
@@ -440,9 +433,14 @@ mod tests {
                         )[0]
                         .clone();
                         let (wi, phi_i) = (case.incident_direction(), case.phi_i_deg.to_radians());
+                        let sin_i = theta.to_radians().sin();
                         let roughness = Roughness { x: alpha, y: alpha };
                         for &h in hemispheres {
-                            let peak = specular_peak(&case, h).expect("below the critical angle");
+                            let beyond_critical = h == Hemisphere::T && eta.is_some_and(|eta| sin_i >= eta);
+                            let Some(peak) = specular_peak(&case, h) else {
+                                assert!(beyond_critical, "{ndf} {material} {theta} deg {h:?}: no peak");
+                                continue;
+                            };
                             let sign = if h == Hemisphere::R { 1.0 } else { -1.0 };
                             let widths = |lobe: Lobe| {
                                 let (u, phi) = peak.at;
@@ -455,11 +453,7 @@ mod tests {
                                 "ggx" => widths(specular_part(&Ggx(roughness), &case.material, wi).unwrap()),
                                 _ => widths(specular_part(&Beckmann(roughness), &case.material, wi).unwrap()),
                             };
-                            let mut measured = vec![("cos", peak.scale.0 / u)];
-                            if theta > 0.0 {
-                                measured.push(("phi", peak.scale.1 / phi));
-                            }
-                            for (axis, ratio) in measured {
+                            for (axis, ratio) in [("cos", peak.scale.0 / u), ("phi", peak.scale.1 / phi)] {
                                 println!("{ndf} {alpha} {material:?} {theta} {h:?} {axis}: {ratio:.3}");
                                 assert!(
                                     (0.3..=1.0).contains(&ratio),
