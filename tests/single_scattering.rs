@@ -312,8 +312,9 @@ fn ggx_order_one_albedo_over_the_normals(alpha: f64, wi: DVec3, eta: Option<f64>
 /// P22 ds`, §1.1) and the isotropic Beckmann slopes `P22(s) = exp(-|s|^2 / alpha^2) / (pi
 /// alpha^2)`, the radius `|s| = alpha sqrt(-ln(1 - t))` makes `t` uniform on [0, 1] and `phi`
 /// on [0, 2 pi): `E1 = ∫∫ max(0, wi . m) / (cos theta_i cos theta_m) w G2 dt dphi / 2 pi`, the
-/// `G1` of `D_wi` cancelling that of `E1`. However small alpha is, the integrand varies on a scale of 1 in `t`, with kinks only
-/// where facets turn away from `wi` or send `wo` below the horizon.
+/// `G1` of `D_wi` cancelling that of `E1`. However small alpha is, the integrand varies on a
+/// scale of 1 in `t`, with kinks only where facets turn away from `wi` or send `wo` below the
+/// horizon.
 /// Independent of the bin quadrature, its grading and the reflection and refraction Jacobians;
 /// it shares Lambda, G2 and Fresnel with the model.
 fn beckmann_order_one_albedo_over_the_slopes(alpha: f64, wi: DVec3, eta: Option<f64>, hemisphere: Hemisphere) -> f64 {

@@ -449,9 +449,11 @@ mod tests {
                                     half_width(|phi| lobe(direction(u, phi, phi_i, sign)), phi, (0.0, TAU)),
                                 )
                             };
-                            let (u, phi) = match ndf {
-                                "ggx" => widths(specular_part(&Ggx(roughness), &case.material, wi).unwrap()),
-                                _ => widths(specular_part(&Beckmann(roughness), &case.material, wi).unwrap()),
+                            let (u, phi) = match case.ndf {
+                                NdfKind::Ggx => widths(specular_part(&Ggx(roughness), &case.material, wi).unwrap()),
+                                NdfKind::Beckmann => {
+                                    widths(specular_part(&Beckmann(roughness), &case.material, wi).unwrap())
+                                }
                             };
                             for (axis, ratio) in [("cos", peak.scale.0 / u), ("phi", peak.scale.1 / phi)] {
                                 println!("{ndf} {alpha} {material:?} {theta} {h:?} {axis}: {ratio:.3}");
