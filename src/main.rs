@@ -14,8 +14,8 @@ use smithwalk::engine::run::{Estimator, Shard};
 use smithwalk::engine::shard::write_shard;
 use smithwalk::exports::lut::LutConfig;
 use smithwalk::io::output;
-use smithwalk::setup::config::Config;
 use smithwalk::setup::config::Model;
+use smithwalk::setup::config::{Config, EnergyConfig};
 use smithwalk::{RunOptions, Simulation};
 
 #[derive(Parser)]
@@ -179,6 +179,14 @@ enum Command {
         /// reference code from its binomial variance and its measured rate (docs/performance.md).
         #[arg(long)]
         precision: bool,
+        /// With `--precision`: follow both Fresnel branches (true) or choose one at random
+        /// (false), as `[energy] split` of a config (default: the config's default, true).
+        #[arg(long, requires = "precision")]
+        split: Option<bool>,
+        /// With `--precision`: the weight below which paths stop splitting and play Russian
+        /// roulette, as `[energy] threshold` of a config (default: the config's default, 0.1).
+        #[arg(long, requires = "precision")]
+        threshold: Option<f64>,
     },
 }
 
@@ -231,9 +239,18 @@ fn bench(paths: u64, repeats: usize) -> Result<()> {
 /// CPU-second on 1 thread, then per albedo (orders 1, 2, 3 and all, R then T) the CPU seconds to
 /// a 1% relative standard error and, in brackets, the reference's time over it (`-`: no light
 /// goes there; `exact`: no variance, as the all-orders reflection of a conductor with F = 1).
-fn bench_precision(paths: u64) -> Result<()> {
-    use smithwalk::engine::bench::{precision_cases, time_to_precision};
+fn bench_precision(paths: u64, energy: &EnergyConfig) -> Result<()> {
+    use smithwalk::engine::bench::{precision_cases, precision_config, time_to_precision};
+    // The cases' configurations with this policy and photon count are checked before the table
+    // starts.
+    for (_, toml, alpha, theta) in precision_cases() {
+        precision_config(toml, (alpha, theta), energy, paths)?;
+    }
     let mut out = std::io::stdout().lock();
+    let policy = format!("[energy] split = {}, threshold = {}", energy.split, energy.threshold);
+    if !print_line(&mut out, &policy)? {
+        return Ok(());
+    }
     let quantities = ["R1", "R2", "R3", "R", "T1", "T2", "T3", "T"];
     let mut header = format!("{:<28} {:>12}", "case (alpha, theta_i rad)", "paths/cpu-s");
     for q in quantities {
@@ -243,7 +260,7 @@ fn bench_precision(paths: u64) -> Result<()> {
         return Ok(());
     }
     for (material, toml, alpha, theta) in precision_cases() {
-        let (rate, albedos) = time_to_precision(material, toml, alpha, theta, paths)?;
+        let (rate, albedos) = time_to_precision(material, toml, (alpha, theta), energy, paths)?;
         let mut row = format!("{:<28} {rate:>12.3e}", format!("{material} {alpha} {theta}"));
         for a in albedos {
             let cell = match a {
@@ -590,7 +607,14 @@ fn main() -> ExitCode {
             let out = out.unwrap_or_else(|| run_dir.join("brdf.bsdf"));
             smithwalk::exports::rgl::export(&run_dir, &out, resolution).map(|p| println!("wrote {}", p.display()))
         }
-        Command::Bench { paths, precision: true, .. } => bench_precision(paths),
+        Command::Bench { paths, precision: true, split, threshold, .. } => {
+            let default = EnergyConfig::default();
+            let energy = EnergyConfig {
+                split: split.unwrap_or(default.split),
+                threshold: threshold.unwrap_or(default.threshold),
+            };
+            bench_precision(paths, &energy)
+        }
         Command::Bench { paths, repeats, .. } => bench(paths, repeats),
     };
     match result {

@@ -10,7 +10,7 @@ use rustix::time::{ClockId, clock_gettime};
 
 use crate::engine::detector::Hemisphere;
 use crate::engine::simulate;
-use crate::setup::config::Config;
+use crate::setup::config::{Config, EnergyConfig};
 
 /// The reference cases: (label, `[surface]` and `[material]` TOML, theta_i in degrees).
 pub const CASES: [(&str, &str, f64); 5] = [
@@ -128,6 +128,16 @@ pub fn reference_paths_per_second(material: &str) -> f64 {
     }
 }
 
+/// The run configuration of a time-to-precision case (the `[material]` TOML `toml` at
+/// `(alpha, theta_i in radians)`) with `paths` photons under `energy`; an error that names the
+/// field if `energy` or `paths` is not allowed.
+pub fn precision_config(toml: &str, (alpha, theta): (f64, f64), energy: &EnergyConfig, paths: u64) -> Result<Config> {
+    Ok(Config::parse(&format!(
+        "paths = {paths}\nseed = 1\n[surface]\nalpha = {alpha}\n[material]\n{toml}\n[incident]\ntheta_rad = {theta}\n[detector]\nmax_order = 4\n[energy]\nsplit = {}\nthreshold = {:e}\n",
+        energy.split, energy.threshold
+    ))?)
+}
+
 /// One per-order albedo of a time-to-precision measurement.
 #[derive(Clone, Copy, Debug)]
 pub struct Precision {
@@ -140,19 +150,19 @@ pub struct Precision {
 }
 
 /// Time to a relative standard error of 1% on the albedos of orders 1, 2, 3 and all, R then T,
-/// of one case on 1 thread: smithwalk's per-photon variance (`stderr^2 N`) over its measured
-/// paths per CPU-second, against the reference's binomial variance `p (1 - p)` (it walks
-/// unit-weight photons with coin escapes) over its rate. `None` where no light goes.
+/// of one case on 1 thread under the split and roulette policy `energy`: smithwalk's
+/// per-photon variance (`stderr^2 N`) over its measured paths per CPU-second, against the
+/// reference's binomial variance `p (1 - p)` (it walks unit-weight photons with coin escapes)
+/// over its rate. `None` where no light goes. An error names the field if `energy` is not a
+/// valid `[energy]` table.
 pub fn time_to_precision(
     material: &str,
     toml: &str,
-    alpha: f64,
-    theta: f64,
+    (alpha, theta): (f64, f64),
+    energy: &EnergyConfig,
     paths: u64,
 ) -> Result<(f64, Vec<Option<Precision>>)> {
-    let config = Config::parse(&format!(
-        "paths = {paths}\nseed = 1\n[surface]\nalpha = {alpha}\n[material]\n{toml}\n[incident]\ntheta_rad = {theta}\n[detector]\nmax_order = 4\n"
-    ))?;
+    let config = precision_config(toml, (alpha, theta), energy, paths)?;
     let cpu = process_cpu_time();
     let sim = simulate(&config, Some(1), false)?;
     let rate = paths as f64 / (process_cpu_time() - cpu).as_secs_f64();
@@ -190,12 +200,40 @@ mod tests {
         // the ratio of the rates (times (N - 1) / N: smithwalk's variance is the unbiased sample
         // variance), and the all-orders albedo (1, without variance) is exact.
         let n = 20_000;
-        let (rate, albedos) = time_to_precision("conductor", "kind = \"conductor\"", 0.5, 1.0, n).unwrap();
+        let energy = EnergyConfig::default();
+        let (rate, albedos) = time_to_precision("conductor", "kind = \"conductor\"", (0.5, 1.0), &energy, n).unwrap();
         let ratio = rate / reference_paths_per_second("conductor") * (n - 1) as f64 / n as f64;
         for a in albedos[..3].iter().map(|a| a.expect("orders 1 to 3 reflect light")) {
             assert!((a.speedup / ratio - 1.0).abs() < 1e-9, "{} against {ratio}", a.speedup);
         }
         assert_eq!(albedos[3].map(|a| a.seconds), Some(0.0));
         assert!(albedos[4..].iter().all(Option::is_none), "a conductor transmits nothing");
+    }
+
+    #[test]
+    fn the_policy_reaches_the_walk() {
+        // Without splitting and without roulette a dielectric walks photons of weight 1 with one
+        // escape each, like the reference: every albedo, R and T, per order and in all, gains
+        // the ratio of the rates (times (N - 1) / N). With splitting (the default) photons carry
+        // Fresnel weights and the gains differ from albedo to albedo.
+        let (n, dielectric) = (20_000, "kind = \"dielectric\"\neta = 1.5");
+        let unit = EnergyConfig { split: false, threshold: 0.0 };
+        let (rate, albedos) = time_to_precision("dielectric", dielectric, (0.5, 1.0), &unit, n).unwrap();
+        let ratio = rate / reference_paths_per_second("dielectric") * (n - 1) as f64 / n as f64;
+        for a in albedos.iter().map(|a| a.expect("a dielectric reflects and transmits every order")) {
+            assert!((a.speedup / ratio - 1.0).abs() < 1e-9, "{} against {ratio}", a.speedup);
+        }
+        let (rate, albedos) =
+            time_to_precision("dielectric", dielectric, (0.5, 1.0), &EnergyConfig::default(), n).unwrap();
+        let ratio = rate / reference_paths_per_second("dielectric") * (n - 1) as f64 / n as f64;
+        let speedups: Vec<f64> = albedos.iter().map(|a| a.unwrap().speedup / ratio).collect();
+        assert!(speedups.iter().any(|s| (s - 1.0).abs() > 0.1), "split photons gain like unit ones: {speedups:?}");
+    }
+
+    #[test]
+    fn a_bad_policy_names_its_field() {
+        let bad = EnergyConfig { split: true, threshold: 0.0 };
+        let err = precision_config("kind = \"conductor\"", (0.5, 1.0), &bad, 100).unwrap_err();
+        assert!(err.to_string().contains("energy.threshold"), "{err}");
     }
 }
