@@ -243,8 +243,9 @@ fn bench_precision(paths: u64, energy: &EnergyConfig) -> Result<()> {
     use smithwalk::engine::bench::{precision_cases, precision_config, time_to_precision};
     // The cases' configurations with this policy and photon count are checked before the table
     // starts.
-    for (_, toml, alpha, theta) in precision_cases() {
-        precision_config(toml, (alpha, theta), energy, paths)?;
+    let cases = precision_cases();
+    for case in &cases {
+        precision_config(case, energy, paths)?;
     }
     let mut out = std::io::stdout().lock();
     let policy = format!("[energy] split = {}, threshold = {}", energy.split, energy.threshold);
@@ -259,9 +260,9 @@ fn bench_precision(paths: u64, energy: &EnergyConfig) -> Result<()> {
     if !print_line(&mut out, &header)? {
         return Ok(());
     }
-    for (material, toml, alpha, theta) in precision_cases() {
-        let (rate, albedos) = time_to_precision(material, toml, (alpha, theta), energy, paths)?;
-        let mut row = format!("{:<28} {rate:>12.3e}", format!("{material} {alpha} {theta}"));
+    for case in &cases {
+        let (rate, albedos) = time_to_precision(case, energy, paths)?;
+        let mut row = format!("{:<28} {rate:>12.3e}", format!("{} {} {}", case.material, case.alpha, case.theta));
         for a in albedos {
             let cell = match a {
                 None => "-".to_string(),

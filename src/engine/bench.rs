@@ -100,38 +100,55 @@ pub fn measure_pair(case: usize, paths: u64) -> Result<f64> {
     Ok(2.0 * a?.paths_per_second.min(b?.paths_per_second))
 }
 
-/// The cases of the time-to-precision table: GGX conductor (F = 1), dielectric (eta 1.5) and
-/// Lambertian (albedo 1) facets, each at (alpha, theta_i in radians) of the Heitz 2016
-/// comparison (0.5, 1.0) and at alpha 0.25 and 1.0, normal and 1.5 rad incidence.
-pub fn precision_cases() -> Vec<(&'static str, &'static str, f64, f64)> {
-    let materials = [
-        ("conductor", "kind = \"conductor\""),
-        ("dielectric", "kind = \"dielectric\"\neta = 1.5"),
-        ("lambertian", "kind = \"diffuse\"\nalbedo = 1.0"),
-    ];
-    let angles = [(0.5, 1.0), (0.25, 0.0), (0.25, 1.5), (1.0, 0.0), (1.0, 1.5)];
-    materials
+/// A case of the time-to-precision table: a GGX facet material at `(alpha, theta_i in radians)`
+/// and the rate of the Heitz et al. 2016 reference code on it.
+#[derive(Clone, Copy, Debug)]
+pub struct PrecisionCase {
+    /// `conductor`, `dielectric` or `lambertian`.
+    pub material: &'static str,
+    /// Its `[material]` table.
+    pub toml: &'static str,
+    pub alpha: f64,
+    pub theta: f64,
+    /// Paths per CPU-second of the reference code on this case (docs/performance.md).
+    pub reference_rate: f64,
+}
+
+/// The incidences of the time-to-precision table, (alpha, theta_i in radians): the Heitz 2016
+/// comparison (0.5, 1.0), and alpha 0.25 and 1.0 at normal and 1.5 rad incidence.
+const PRECISION_ANGLES: [(f64, f64); 5] = [(0.5, 1.0), (0.25, 0.0), (0.25, 1.5), (1.0, 0.0), (1.0, 1.5)];
+
+/// The materials of the time-to-precision table: GGX conductor (F = 1), dielectric (eta 1.5)
+/// and Lambertian (albedo 1) facets, each with the paths per CPU-second of the Heitz et al.
+/// 2016 reference code (its public release, `float`, GGX, uniform heights, built with `g++
+/// -O2`) at each of [`PRECISION_ANGLES`], measured on the host of docs/performance.md (the
+/// fastest of three runs of 2·10^6 paths each, alternated with smithwalk's bench).
+const PRECISION_MATERIALS: [(&str, &str, [f64; 5]); 3] = [
+    ("conductor", "kind = \"conductor\"", [3.00e6, 5.31e6, 3.86e6, 2.12e6, 3.62e6]),
+    ("dielectric", "kind = \"dielectric\"\neta = 1.5", [3.25e6, 5.07e6, 3.02e6, 4.35e6, 1.44e6]),
+    ("lambertian", "kind = \"diffuse\"\nalbedo = 1.0", [2.62e6, 4.34e6, 3.13e6, 2.11e6, 2.18e6]),
+];
+
+/// The 15 cases of the time-to-precision table, material by material.
+pub fn precision_cases() -> Vec<PrecisionCase> {
+    PRECISION_MATERIALS
         .iter()
-        .flat_map(|&(name, toml)| angles.iter().map(move |&(alpha, theta)| (name, toml, alpha, theta)))
+        .flat_map(|&(material, toml, rates)| {
+            PRECISION_ANGLES.iter().zip(rates).map(move |(&(alpha, theta), reference_rate)| PrecisionCase {
+                material,
+                toml,
+                alpha,
+                theta,
+                reference_rate,
+            })
+        })
         .collect()
 }
 
-/// Paths per CPU-second of the Heitz et al. 2016 reference code (`-O2`, its `float` build)
-/// per material, as measured for the throughput issue on this kind of machine: 2.5-2.7 M for
-/// the conductor; 2.9 M for the dielectric; 2.1-2.9 M over the materials. The top of each
-/// range is used (the Lambertian's is not given apart: 2.9 M), so that the speed-ups below
-/// are not flattered.
-pub fn reference_paths_per_second(material: &str) -> f64 {
-    match material {
-        "conductor" => 2.7e6,
-        _ => 2.9e6,
-    }
-}
-
-/// The run configuration of a time-to-precision case (the `[material]` TOML `toml` at
-/// `(alpha, theta_i in radians)`) with `paths` photons under `energy`; an error that names the
-/// field if `energy` or `paths` is not allowed.
-pub fn precision_config(toml: &str, (alpha, theta): (f64, f64), energy: &EnergyConfig, paths: u64) -> Result<Config> {
+/// The run configuration of a time-to-precision case with `paths` photons under `energy`; an
+/// error that names the field if `energy` or `paths` is not allowed.
+pub fn precision_config(case: &PrecisionCase, energy: &EnergyConfig, paths: u64) -> Result<Config> {
+    let PrecisionCase { toml, alpha, theta, .. } = case;
     Ok(Config::parse(&format!(
         "paths = {paths}\nseed = 1\n[surface]\nalpha = {alpha}\n[material]\n{toml}\n[incident]\ntheta_rad = {theta}\n[detector]\nmax_order = 4\n[energy]\nsplit = {}\nthreshold = {:e}\n",
         energy.split, energy.threshold
@@ -156,17 +173,15 @@ pub struct Precision {
 /// over its rate. `None` where no light goes. An error names the field if `energy` is not a
 /// valid `[energy]` table.
 pub fn time_to_precision(
-    material: &str,
-    toml: &str,
-    (alpha, theta): (f64, f64),
+    case: &PrecisionCase,
     energy: &EnergyConfig,
     paths: u64,
 ) -> Result<(f64, Vec<Option<Precision>>)> {
-    let config = precision_config(toml, (alpha, theta), energy, paths)?;
+    let config = precision_config(case, energy, paths)?;
     let cpu = process_cpu_time();
     let sim = simulate(&config, Some(1), false)?;
     let rate = paths as f64 / (process_cpu_time() - cpu).as_secs_f64();
-    let reference = reference_paths_per_second(material);
+    let reference = case.reference_rate;
     let result = &sim.results[0];
     let mut out = Vec::new();
     for hemisphere in [Hemisphere::R, Hemisphere::T] {
@@ -193,6 +208,13 @@ pub fn time_to_precision(
 mod tests {
     use super::*;
 
+    /// The first case of `material` in the table: alpha 0.5 at 1 rad.
+    fn case_of(material: &str) -> PrecisionCase {
+        let case = precision_cases().into_iter().find(|c| c.material == material).unwrap();
+        assert_eq!((case.alpha, case.theta), (0.5, 1.0));
+        case
+    }
+
     #[test]
     fn unit_weight_walks_gain_exactly_their_throughput_ratio() {
         // A conductor with F = 1 walks photons of weight 1 with one escape each, like the
@@ -200,9 +222,9 @@ mod tests {
         // the ratio of the rates (times (N - 1) / N: smithwalk's variance is the unbiased sample
         // variance), and the all-orders albedo (1, without variance) is exact.
         let n = 20_000;
-        let energy = EnergyConfig::default();
-        let (rate, albedos) = time_to_precision("conductor", "kind = \"conductor\"", (0.5, 1.0), &energy, n).unwrap();
-        let ratio = rate / reference_paths_per_second("conductor") * (n - 1) as f64 / n as f64;
+        let case = case_of("conductor");
+        let (rate, albedos) = time_to_precision(&case, &EnergyConfig::default(), n).unwrap();
+        let ratio = rate / case.reference_rate * (n - 1) as f64 / n as f64;
         for a in albedos[..3].iter().map(|a| a.expect("orders 1 to 3 reflect light")) {
             assert!((a.speedup / ratio - 1.0).abs() < 1e-9, "{} against {ratio}", a.speedup);
         }
@@ -216,16 +238,15 @@ mod tests {
         // escape each, like the reference: every albedo, R and T, per order and in all, gains
         // the ratio of the rates (times (N - 1) / N). With splitting (the default) photons carry
         // Fresnel weights and the gains differ from albedo to albedo.
-        let (n, dielectric) = (20_000, "kind = \"dielectric\"\neta = 1.5");
+        let (n, case) = (20_000, case_of("dielectric"));
         let unit = EnergyConfig { split: false, threshold: 0.0 };
-        let (rate, albedos) = time_to_precision("dielectric", dielectric, (0.5, 1.0), &unit, n).unwrap();
-        let ratio = rate / reference_paths_per_second("dielectric") * (n - 1) as f64 / n as f64;
+        let (rate, albedos) = time_to_precision(&case, &unit, n).unwrap();
+        let ratio = rate / case.reference_rate * (n - 1) as f64 / n as f64;
         for a in albedos.iter().map(|a| a.expect("a dielectric reflects and transmits every order")) {
             assert!((a.speedup / ratio - 1.0).abs() < 1e-9, "{} against {ratio}", a.speedup);
         }
-        let (rate, albedos) =
-            time_to_precision("dielectric", dielectric, (0.5, 1.0), &EnergyConfig::default(), n).unwrap();
-        let ratio = rate / reference_paths_per_second("dielectric") * (n - 1) as f64 / n as f64;
+        let (rate, albedos) = time_to_precision(&case, &EnergyConfig::default(), n).unwrap();
+        let ratio = rate / case.reference_rate * (n - 1) as f64 / n as f64;
         let speedups: Vec<f64> = albedos.iter().map(|a| a.unwrap().speedup / ratio).collect();
         assert!(speedups.iter().any(|s| (s - 1.0).abs() > 0.1), "split photons gain like unit ones: {speedups:?}");
     }
@@ -233,7 +254,7 @@ mod tests {
     #[test]
     fn a_bad_policy_names_its_field() {
         let bad = EnergyConfig { split: true, threshold: 0.0 };
-        let err = precision_config("kind = \"conductor\"", (0.5, 1.0), &bad, 100).unwrap_err();
+        let err = precision_config(&case_of("conductor"), &bad, 100).unwrap_err();
         assert!(err.to_string().contains("energy.threshold"), "{err}");
     }
 }
