@@ -235,7 +235,8 @@ fn channel_header(rgb: bool) -> Vec<&'static str> {
 pub(crate) fn bin_edges(grid: Grid, sign: f64) -> impl Iterator<Item = (usize, usize, [f64; 4])> {
     (0..grid.cos_bins).flat_map(move |ic| {
         let (lo, hi) = grid.cos_edges(ic);
-        let (cos_lo, cos_hi) = if sign > 0.0 { (lo, hi) } else { (-hi, -lo) };
+        // `0.0 - lo`, not `-lo`: the horizon's edge of a transmission bin is written `0`, not `-0`.
+        let (cos_lo, cos_hi) = if sign > 0.0 { (lo, hi) } else { (-hi, 0.0 - lo) };
         (0..grid.phi_bins).map(move |ip| {
             let (phi_lo, phi_hi) = grid.phi_edges_deg(ip);
             (ic, ic * grid.phi_bins + ip, [cos_lo, cos_hi, phi_lo, phi_hi])
@@ -487,4 +488,26 @@ pub fn write_outputs(sim: &Simulation, config: &Config, dir: &Path) -> Result<Ve
         }
     }
     write_atomically(dir, &[(TABLES[0], lobes), (TABLES[1], summary), ("run.json", run)])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bin_edges_are_signed_by_hemisphere_without_negative_zero() {
+        let grid = Grid { cos_bins: 4, phi_bins: 3 };
+        for sign in [1.0, -1.0] {
+            let edges: Vec<_> = bin_edges(grid, sign).collect();
+            assert_eq!(edges.len(), 12);
+            for (ic, _, [lo, hi, _, _]) in edges {
+                assert!(lo < hi, "{lo} {hi}");
+                let (a, b) = grid.cos_edges(ic);
+                assert_eq!((lo.abs().min(hi.abs()), lo.abs().max(hi.abs())), (a, b));
+                assert!(lo * sign >= 0.0 && hi * sign >= 0.0, "{lo} {hi} in hemisphere {sign}");
+                // `-0` would be written to lobes.csv as "-0".
+                assert!(lo.to_string() != "-0" && hi.to_string() != "-0", "{lo} {hi}");
+            }
+        }
+    }
 }
