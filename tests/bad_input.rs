@@ -109,6 +109,22 @@ fn run(config: &str, args: &[&str]) -> (Option<i32>, String) {
 }
 
 #[test]
+fn an_unreadable_config_gives_its_cause_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let path = dir.path().join("quickstart.tom");
+    let out = Command::new(env!("CARGO_BIN_EXE_smithwalk"))
+        .args(["run", path.to_str().unwrap(), "--out", out_dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(!out_dir.exists());
+    assert!(e.starts_with("error: cannot read config ") && e.contains("quickstart.tom: "), "{e}");
+    assert_eq!(e.matches("os error 2").count(), 1, "{e}");
+}
+
+#[test]
 fn limits_are_checked_before_any_work() {
     // Once a loop over every chunk of 10^19 photons, and minutes of spawning threads.
     let (code, e) = run(BASE, &["--paths", "10000000000000000000"]);

@@ -577,8 +577,10 @@ fn default_seed() -> u64 {
 /// A configuration error: which field, which value, and what is allowed.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
-    #[error("cannot read config {path}: {source}")]
-    Read { path: String, source: std::io::Error },
+    /// The cause is part of the message and not the error's `source`, so that a chain of
+    /// errors (`{:#}`) prints it once.
+    #[error("cannot read config {path}: {cause}")]
+    Read { path: String, cause: std::io::Error },
     #[error("config {path} is not valid: {message}")]
     Parse { path: String, message: String },
     #[error("`{field}` = {value} is not allowed: {allowed}")]
@@ -593,7 +595,7 @@ impl Config {
     /// Reads, parses and validates a TOML configuration file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
         let text = std::fs::read_to_string(path)
-            .map_err(|source| ConfigError::Read { path: path.display().to_string(), source })?;
+            .map_err(|cause| ConfigError::Read { path: path.display().to_string(), cause })?;
         let config = Self::parse(&text).map_err(|e| match e {
             ConfigError::Parse { message, .. } => ConfigError::Parse { path: path.display().to_string(), message },
             other => other,

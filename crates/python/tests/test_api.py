@@ -1,7 +1,9 @@
 """The Python API: config forms, shapes and dtypes, labels, errors with the command line's
 messages, comparisons, the GIL, Ctrl-C, life without pandas, docstrings."""
 
+import errno
 import inspect
+import os
 import pydoc
 import signal
 import subprocess
@@ -143,8 +145,9 @@ def test_bad_arguments(tmp_path):
         smithwalk.run(MONO, paths=1e5)
     with pytest.raises(TypeError, match="TOML string, a path or a dict"):
         smithwalk.run(42)
-    with pytest.raises(OSError, match="cannot read config"):
-        smithwalk.run(tmp_path / "missing.toml")
+    with pytest.raises(OSError, match="cannot read config") as error:
+        smithwalk.run(tmp_path / "quickstart.tom")
+    assert str(error.value).count(os.strerror(errno.ENOENT)) == 1, error.value
     with pytest.raises(ValueError, match="is not TOML|not valid"):
         smithwalk.run({"paths": 1000, "surface": {"alpha": None}})
     with pytest.raises(ValueError, match="run.json"):
