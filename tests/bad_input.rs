@@ -30,7 +30,32 @@ fn every_bad_config_names_its_field_value_and_what_is_allowed() {
         (with("alpha = 0.5", "alpha = 0.5\nsmith = \"Exact\""), ["`surface.smith` = \"Exact\"", "`exact`"]),
         (with("alpha = 0.5", "alpha = 0.5\nnormals = \"foo\""), ["`surface.normals` = \"foo\"", "`vndf`"]),
         (with("\"conductor\"", "\"conductor\"\ncolor = 3"), ["`material.color` is not a known key", "`fresnel`"]),
-        (with("\"conductor\"", "\"dielectric\""), ["`material.eta` is missing", "missing field `eta`"]),
+        (
+            with("\"conductor\"", "\"dielectric\""),
+            ["`material.eta` is missing from the table at line 4", "n_inside / n_outside, > 0 and != 1"],
+        ),
+        // A key that a Fresnel kind needs: what it must be, with no "= missing".
+        (
+            with("\"conductor\"", "\"conductor\"\nfresnel = \"schlick\""),
+            ["`material.f0` is missing: fresnel = \"schlick\" needs a reflectance in [0, 1]", "[r, g, b]"],
+        ),
+        (
+            with("\"conductor\"", "\"conductor\"\nfresnel = \"exact\"\neta = 0.2"),
+            ["`material.k` is missing: fresnel = \"exact\" needs the extinction coefficient, >= 0", "[r, g, b]"],
+        ),
+        (
+            with("theta_deg = 30", "phi_deg = 30"),
+            ["`incident.theta_deg` is missing: a polar angle in [0, 90)", "`theta_rad`"],
+        ),
+        // One material table is `material`, as the text names it; a list's are `material[i]`.
+        (with("\"conductor\"", "\"dielectric\"\neta = 1.0"), ["`material.eta` = 1 is not allowed", "!= 1"]),
+        (
+            with(
+                "[material]\nkind = \"conductor\"",
+                "[[material]]\nkind = \"conductor\"\n[[material]]\nkind = \"dielectric\"",
+            ),
+            ["`material[1].eta` is missing from the table at line 6", "n_inside / n_outside"],
+        ),
         // A value inside a material is named by its key and line, though serde reports it at
         // the whole table (tagged by `kind`).
         (
@@ -52,7 +77,11 @@ fn every_bad_config_names_its_field_value_and_what_is_allowed() {
             with("alpha = 0.5", "alpha = [[0.1, 0.2, 0.3]]"),
             ["`surface.alpha[0]` = [0.1, 0.2, 0.3]", "[alpha_x, alpha_y]"],
         ),
-        (with("alpha = 0.5", "alpha = 1e5"), ["`surface.alpha` = 100000", "> 0 and at most 1e4"]),
+        // Range checks name the config, like the errors found while reading it.
+        (
+            with("alpha = 0.5", "alpha = 1e5"),
+            ["config <text> is not valid: `surface.alpha` = 100000 is not allowed", "> 0 and at most 1e4"],
+        ),
         (with("paths = 1000", "paths = 1_000_000_000_000_001"), ["`paths` = 1000000000000001", "at most 10^15"]),
         (
             format!("{BASE}[detector]\nmax_order = 4\n[precision]\ntarget_rel_stderr = 0.01\norders = 1000\n"),
@@ -106,6 +135,47 @@ fn run(config: &str, args: &[&str]) -> (Option<i32>, String) {
         .unwrap();
     assert!(!out_dir.exists(), "{args:?}: an output directory was made");
     (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+#[test]
+fn a_missing_table_or_key_says_what_is_expected_with_no_output() {
+    let without = |part: &str| {
+        assert!(BASE.contains(part), "{part:?}");
+        BASE.replace(part, "")
+    };
+    let cases = [
+        (without("[incident]\ntheta_deg = 30\n"), "`[incident]` is missing: a table with `theta_deg` or `theta_rad`"),
+        (without("paths = 1000\n"), "`paths` is missing: photons per case, from 2 to 10^15"),
+        (without("[surface]\nalpha = 0.5\n"), "`[surface]` is missing: a table with `alpha`"),
+        (without("[material]\nkind = \"conductor\"\n"), "`[material]` is missing: a table with `kind` = \"conductor\""),
+        (without("alpha = 0.5\n"), "`surface.alpha` is missing from the table at line 2: a roughness > 0"),
+        (without("kind = \"conductor\"\n"), "`material.kind` is missing from the table at line 4: \"conductor\""),
+    ];
+    for (config, expected) in cases {
+        let (code, e) = run(&config, &[]);
+        assert_eq!(code, Some(1), "{e}");
+        assert!(e.starts_with("error: config ") && e.contains("c.toml is not valid: "), "{e}");
+        assert!(e.contains(expected), "{e:?} lacks {expected:?}");
+        // A line number only where it points at the table the key belongs in.
+        assert_eq!(e.contains("(line") || e.contains("at line"), expected.contains("at line"), "{e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+}
+
+#[test]
+fn an_unreadable_config_gives_its_cause_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let path = dir.path().join("quickstart.tom");
+    let out = Command::new(env!("CARGO_BIN_EXE_smithwalk"))
+        .args(["run", path.to_str().unwrap(), "--out", out_dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(!out_dir.exists());
+    assert!(e.starts_with("error: cannot read config ") && e.contains("quickstart.tom: "), "{e}");
+    assert_eq!(e.matches("os error 2").count(), 1, "{e}");
 }
 
 #[test]

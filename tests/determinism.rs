@@ -95,17 +95,17 @@ fn rejects(from: &str, to: &str, expect: &[&str]) {
 
 /// (text to replace in a good config, its replacement, what the error must mention)
 const BAD_INPUT: [(&str, &str, &[&str]); 15] = [
-    ("paths = 1000\n", "", &["missing field `paths`"]),
+    ("paths = 1000\n", "", &["`paths` is missing", "photons per case"]),
     ("[surface]", "colour = 3\n[surface]", &["unknown field `colour`"]),
     ("alpha = 0.5", "alpha = -0.5", &["surface.alpha", "-0.5", "> 0"]),
     ("alpha = 0.5", "alpha = [0.5, 0.0]", &["surface.alpha", "0", "> 0"]),
     ("alpha = 0.5", "alpha = []", &["surface.alpha", "at least one value"]),
-    ("kind = \"conductor\"", "kind = \"dielectric\"\neta = -1.5", &["material[0].eta", "-1.5", "> 0"]),
-    ("kind = \"conductor\"", "kind = \"dielectric\"\neta = 1.0", &["material[0].eta", "!= 1"]),
+    ("kind = \"conductor\"", "kind = \"dielectric\"\neta = -1.5", &["material.eta", "-1.5", "> 0"]),
+    ("kind = \"conductor\"", "kind = \"dielectric\"\neta = 1.0", &["material.eta", "!= 1"]),
     (
         "kind = \"conductor\"",
         "kind = \"conductor\"\nfresnel = \"exact\"",
-        &["material[0].eta", "missing", "needs `eta`"],
+        &["`material.eta` is missing", "fresnel = \"exact\" needs"],
     ),
     ("theta_deg = 30", "theta_deg = 90", &["incident.theta_deg", "90", "[0, 90)"]),
     ("theta_deg = 30", "theta_deg = -1", &["incident.theta_deg", "-1"]),

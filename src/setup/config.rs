@@ -577,34 +577,52 @@ fn default_seed() -> u64 {
 /// A configuration error: which field, which value, and what is allowed.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
-    #[error("cannot read config {path}: {source}")]
-    Read { path: String, source: std::io::Error },
+    /// The cause is part of the message and not the error's `source`, so that a chain of
+    /// errors (`{:#}`) prints it once.
+    #[error("cannot read config {path}: {cause}")]
+    Read { path: String, cause: std::io::Error },
     #[error("config {path} is not valid: {message}")]
     Parse { path: String, message: String },
     #[error("`{field}` = {value} is not allowed: {allowed}")]
     Invalid { field: String, value: String, allowed: String },
+    /// A required table or key that is absent; `place` is empty or says where it belongs.
+    #[error("`{field}` is missing{place}: {allowed}")]
+    Missing { field: String, place: String, allowed: String },
+}
+
+impl ConfigError {
+    /// The error as found in the config `path` (a file, `<text>` or `<dict>`): errors of its
+    /// text or values name it; an unreadable file already does.
+    pub fn in_source(self, path: &str) -> Self {
+        match self {
+            ConfigError::Parse { message, .. } => ConfigError::Parse { path: path.into(), message },
+            ConfigError::Read { .. } => self,
+            _ => ConfigError::Parse { path: path.into(), message: self.to_string() },
+        }
+    }
 }
 
 pub(crate) fn invalid(field: impl Into<String>, value: impl fmt::Display, allowed: impl Into<String>) -> ConfigError {
     ConfigError::Invalid { field: field.into(), value: value.to_string(), allowed: allowed.into() }
 }
 
+/// A required table or key that is absent, with what it should be.
+fn missing(field: impl Into<String>, allowed: impl Into<String>) -> ConfigError {
+    ConfigError::Missing { field: field.into(), place: String::new(), allowed: allowed.into() }
+}
+
 impl Config {
     /// Reads, parses and validates a TOML configuration file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
         let text = std::fs::read_to_string(path)
-            .map_err(|source| ConfigError::Read { path: path.display().to_string(), source })?;
-        let config = Self::parse(&text).map_err(|e| match e {
-            ConfigError::Parse { message, .. } => ConfigError::Parse { path: path.display().to_string(), message },
-            other => other,
-        })?;
-        Ok(config)
+            .map_err(|cause| ConfigError::Read { path: path.display().to_string(), cause })?;
+        Self::parse(&text).map_err(|e| e.in_source(&path.display().to_string()))
     }
 
-    /// Parses and validates TOML text.
+    /// Parses and validates TOML text; errors name it `<text>`.
     pub fn parse(text: &str) -> Result<Self, ConfigError> {
         let config: Config = parse_toml(text)?;
-        config.validate()?;
+        config.validate().map_err(|e| e.in_source("<text>"))?;
         Ok(config)
     }
 
@@ -648,7 +666,12 @@ impl Config {
             return Err(invalid("material", "[]", "at least one material"));
         }
         for (i, m) in materials.iter().enumerate() {
-            validate_material(&format!("material[{i}]"), m)?;
+            // Named as the text names it: `material` for one table, `material[i]` in a list.
+            let field = match self.material {
+                OneOrMany::One(_) => "material".to_string(),
+                OneOrMany::Many(_) => format!("material[{i}]"),
+            };
+            validate_material(&field, m)?;
         }
         let i = &self.incident;
         if i.theta_deg.is_some() && i.theta_rad.is_some() {
@@ -662,7 +685,8 @@ impl Config {
             (Some(d), _) => ("incident.theta_deg", d.values(), 90.0),
             (None, Some(r)) => ("incident.theta_rad", r.values(), std::f64::consts::FRAC_PI_2),
             (None, None) => {
-                return Err(invalid("incident.theta_deg", "missing", "a polar angle or a list of them"));
+                let allowed = required("incident.theta_deg").expect("described");
+                return Err(missing("incident.theta_deg", allowed));
             }
         };
         if values.is_empty() {
@@ -742,12 +766,8 @@ impl Config {
 /// as written (shortened) and what is allowed, whatever the input's size.
 pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, ConfigError> {
     let parse = |message: String| ConfigError::Parse { path: "<text>".into(), message };
-    let at = |e: &toml::de::Error| {
-        e.span().map_or(String::new(), |s| {
-            let line = text[..s.start.min(text.len())].matches('\n').count() + 1;
-            format!(" (line {line})")
-        })
-    };
+    let line_of = |e: &toml::de::Error| e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+    let at = |e: &toml::de::Error| at_line(line_of(e));
     let deserializer = toml::de::Deserializer::parse(text)
         .map_err(|e| parse(format!("not TOML{}: {}", at(&e), shorten(e.message(), MESSAGE_CHARS))))?;
     serde_path_to_error::deserialize(deserializer).map_err(|e| {
@@ -763,18 +783,64 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, Confi
                 let field = if field.ends_with(k) { field } else { format!("{field}.{k}") };
                 parse(format!("`{field}` is not a known key{line}: {allowed}"))
             }
+            // At the top level the span is the whole text: no line says where the key belongs.
+            (None, Some(k)) if field == "." => {
+                let field = if k == "paths" { k.to_string() } else { format!("[{k}]") };
+                let allowed = required(k).unwrap_or(allowed);
+                parse(ConfigError::Missing { field, place: String::new(), allowed }.to_string())
+            }
             (None, Some(k)) => {
-                parse(format!("`{}` is missing{line}: {allowed}", format!("{field}.{k}").trim_start_matches(".")))
+                // The span of a table of `[[material]]` is that of the first one.
+                let line = match material_index(&field) {
+                    Some(Some(i)) => material_header(&text.lines().collect::<Vec<_>>(), Some(i)).map(|h| h + 1),
+                    _ => line_of(inner),
+                };
+                let place = line.map_or(String::new(), |n| format!(" from the table at line {n}"));
+                let allowed = required(&format!("{}.{k}", without_indices(&field))).unwrap_or(allowed);
+                parse(ConfigError::Missing { field: format!("{field}.{k}"), place, allowed }.to_string())
             }
             _ if field == "." => parse(format!("{allowed}{line}")),
             _ => match material_culprit(text, &field, inner.message()) {
                 Some(Culprit { key, value, line }) => {
-                    let line = line.map_or(String::new(), |n| format!(" (line {n})"));
+                    let line = at_line(line);
                     parse(format!("`{field}.{key}` = {value} is not allowed{line}: {allowed}"))
                 }
                 None => parse(format!("`{field}` = {value} is not allowed{line}: {allowed}")),
             },
         }
+    })
+}
+
+/// ` (line n)`, or nothing without a line.
+fn at_line(line: Option<usize>) -> String {
+    line.map_or(String::new(), |n| format!(" (line {n})"))
+}
+
+/// `field` without its list indices: `material[1].eta` is `material.eta`.
+fn without_indices(field: &str) -> String {
+    field.split('[').map(|part| part.split_once(']').map_or(part, |(_, rest)| rest)).collect()
+}
+
+/// What a required table or key (its dotted path without list indices) should be, for the
+/// error that says it is missing.
+fn required(key: &str) -> Option<String> {
+    let kinds = "\"conductor\", \"dielectric\", \"diffuse\" or \"hammon\"";
+    Some(match key {
+        "paths" => "photons per case, from 2 to 10^15".into(),
+        "surface" => "a table with `alpha`, the roughness".into(),
+        "material" => format!("a table with `kind` = {kinds}, or several `[[material]]` tables"),
+        "incident" => "a table with `theta_deg` or `theta_rad`, the incident polar angles".into(),
+        "surface.alpha" => "a roughness > 0 and at most 1e4, a list of them (a sweep) or [[alpha_x, alpha_y]]".into(),
+        "material.kind" => kinds.into(),
+        "material.eta" => "the relative index n_inside / n_outside, > 0 and != 1".into(),
+        "incident.theta_deg" => {
+            "a polar angle in [0, 90) or a list of them (or `theta_rad`, in radians, in [0, pi/2))".into()
+        }
+        "compare.models" => {
+            let names: Vec<&str> = Model::ALL.iter().map(|m| m.name()).collect();
+            format!("a list of models from {}", names.join(", "))
+        }
+        _ => return None,
     })
 }
 
@@ -792,10 +858,7 @@ struct Culprit {
 /// table's header (none for an inline table).
 fn material_culprit(text: &str, field: &str, message: &str) -> Option<Culprit> {
     let document: toml::Table = toml::from_str(text).ok()?;
-    let index = match field.strip_prefix("material")? {
-        "" => None,
-        rest => Some(rest.strip_prefix('[')?.strip_suffix(']')?.parse::<usize>().ok()?),
-    };
+    let index = material_index(field)?;
     let table = match (document.get("material")?, index) {
         (toml::Value::Table(t), None) => t,
         (toml::Value::Array(a), Some(i)) => a.get(i)?.as_table()?,
@@ -808,13 +871,8 @@ fn material_culprit(text: &str, field: &str, message: &str) -> Option<Culprit> {
     })?;
     let value = shorten(&table[key].to_string(), VALUE_CHARS);
     // The key's line: the first `key =` after the header of the material's table.
-    let is_header = |l: &str| {
-        let l: String = l.chars().filter(|c| !c.is_whitespace()).collect();
-        l == "[material]" || l == "[[material]]"
-    };
     let lines: Vec<&str> = text.lines().collect();
-    let header = lines.iter().enumerate().filter(|(_, l)| is_header(l)).nth(index.unwrap_or(0)).map(|(n, _)| n);
-    let line = header.and_then(|h| {
+    let line = material_header(&lines, index).and_then(|h| {
         lines[h + 1..]
             .iter()
             .take_while(|l| !l.trim_start().starts_with('['))
@@ -822,6 +880,25 @@ fn material_culprit(text: &str, field: &str, message: &str) -> Option<Culprit> {
             .map(|n| h + 1 + n + 1)
     });
     Some(Culprit { key: key.clone(), value, line })
+}
+
+/// Which material `field` names: `Some(None)` for `material` (one table), `Some(Some(i))` for
+/// `material[i]`, `None` for any other field.
+fn material_index(field: &str) -> Option<Option<usize>> {
+    match field.strip_prefix("material")? {
+        "" => Some(None),
+        rest => Some(Some(rest.strip_prefix('[')?.strip_suffix(']')?.parse::<usize>().ok()?)),
+    }
+}
+
+/// The index (from 0) of the line of the header of material `index` (`[material]`, or the
+/// `index`-th `[[material]]`); none for inline tables.
+fn material_header(lines: &[&str], index: Option<usize>) -> Option<usize> {
+    let is_header = |l: &str| {
+        let l: String = l.chars().filter(|c| !c.is_whitespace()).collect();
+        l == "[material]" || l == "[[material]]"
+    };
+    lines.iter().enumerate().filter(|(_, l)| is_header(l)).nth(index.unwrap_or(0)).map(|(n, _)| n)
 }
 
 /// Longest quoted value and message in a config error.
@@ -860,29 +937,25 @@ fn validate_material(field: &str, m: &MaterialConfig) -> Result<(), ConfigError>
     let unit = |v: f64| (0.0..=1.0).contains(&v);
     match m {
         MaterialConfig::Conductor { fresnel, f0, eta, k, .. } => {
-            let needs = |name: &str, p: &Option<Channels>, present: bool| {
-                if p.is_some() != present {
-                    let allowed = if present {
-                        format!("fresnel = \"{}\" needs `{name}`", fresnel_name(*fresnel))
-                    } else {
-                        format!("`{name}` is not used with fresnel = \"{}\"", fresnel_name(*fresnel))
-                    };
-                    let value = p.map_or("missing".to_string(), |c| c.to_string());
-                    return Err(invalid(format!("{field}.{name}"), value, allowed));
+            // Each parameter: the Fresnel kind that uses it (and needs it), and its range.
+            let params = [
+                ("f0", f0, FresnelKind::Schlick, unit as fn(f64) -> bool, "a reflectance in [0, 1]"),
+                ("eta", eta, FresnelKind::Exact, |v| v > 0.0, "the real part of the index, > 0"),
+                ("k", k, FresnelKind::Exact, |v| v >= 0.0, "the extinction coefficient, >= 0"),
+            ];
+            for (name, value, user, ok, allowed) in params {
+                let key = format!("{field}.{name}");
+                let allowed = format!("{allowed}, or one per channel [r, g, b]");
+                let (kind, user) = (fresnel_name(*fresnel), fresnel_name(user));
+                match value {
+                    None if kind == user => return Err(missing(key, format!("fresnel = \"{user}\" needs {allowed}"))),
+                    Some(c) if kind != user => {
+                        let allowed = format!("`{name}` is used only with fresnel = \"{user}\", not \"{kind}\"");
+                        return Err(invalid(key, c, allowed));
+                    }
+                    Some(c) => check_channels(key, *c, ok, &allowed)?,
+                    None => {}
                 }
-                Ok(())
-            };
-            needs("f0", f0, *fresnel == FresnelKind::Schlick)?;
-            needs("eta", eta, *fresnel == FresnelKind::Exact)?;
-            needs("k", k, *fresnel == FresnelKind::Exact)?;
-            if let Some(f0) = f0 {
-                check_channels(format!("{field}.f0"), *f0, unit, "reflectances in [0, 1]")?;
-            }
-            if let Some(eta) = eta {
-                check_channels(format!("{field}.eta"), *eta, |v| v > 0.0, "real parts of the index > 0")?;
-            }
-            if let Some(k) = k {
-                check_channels(format!("{field}.k"), *k, |v| v >= 0.0, "extinction coefficients >= 0")?;
             }
         }
         MaterialConfig::Dielectric { eta, .. } => {

@@ -48,10 +48,7 @@ fn load_config(source: &str, kind: &str) -> PyResult<Config> {
             let text = toml::to_string(&value).map_err(|e| {
                 PyValueError::new_err(format!("config dict is not valid: {e} (values must be TOML values, not None)"))
             })?;
-            Config::parse(&text).map_err(|e| match e {
-                ConfigError::Parse { message, .. } => ConfigError::Parse { path: "<dict>".into(), message },
-                other => other,
-            })
+            Config::parse(&text).map_err(|e| e.in_source("<dict>"))
         }
         _ => return Err(PyValueError::new_err(format!("unknown config kind {kind:?}"))),
     };
