@@ -1,5 +1,6 @@
 """A first smithwalk session in Python: a small sweep, the Wang et al. 2022 models beside it, the
-per-order lobes in the plane of incidence.
+per-order lobes f·|cos θ_o| in the plane of incidence, drawn as `smithwalk plot` draws them (same
+bins, quantity, labels and model colours).
 
     pip install ./crates/python matplotlib pandas
     python scripts/example.py                  # 10^6 photons per case
@@ -20,7 +21,7 @@ import numpy as np
 
 import smithwalk
 
-# A GGX conductor (F = 1) at two roughnesses and two incident angles; orders 1, 2 and 3+.
+# A GGX conductor (F = 1) at two roughnesses and two incident angles; orders 1, 2, 3+ and all.
 CONFIG = {
     "paths": 1_000_000,
     "seed": 1,
@@ -32,21 +33,32 @@ CONFIG = {
 MODELS = ["wang-correlated", "wang-uncorrelated"]
 
 
-def plane_of_incidence(values, phi_bins, stderr=False):
-    """A lobe (cos_bin, phi_bin) in the plane of incidence: the two phi bins either side of the
-    mirror azimuth (180 deg) and of the incident one (0 deg), averaged; returns (back, mirror).
-    With `stderr`, `values` are standard errors, combined as those of independent bins."""
-    half = phi_bins // 2
-    pairs = ([0, phi_bins - 1], [half - 1, half])
-    if stderr:
-        return tuple(np.sqrt((values[:, p] ** 2).sum(axis=1)) / 2 for p in pairs)
-    return tuple(values[:, p].mean(axis=1) for p in pairs)
+# The fixed style of these models in every smithwalk figure (src/exports/plot/style.rs,
+# scripts/plot_lobes.py): (colour, dash).
+MODEL_STYLE = {"wang-correlated": ("#e69f00", "-"), "wang-uncorrelated": ("#cc79a7", (0, (1, 1.5)))}
+
+
+def plane_of_incidence(energy, cos_edges, phi_edges_deg):
+    """A lobe's energies (cos_bin, phi_bin) in the plane of incidence as `smithwalk plot` draws
+    it: f |cos theta_o|, a bin's energy over its solid angle, in the bins that contain phi = 0
+    (the light's side) and phi = 180 deg (the mirror side); returns (light's side, mirror side)."""
+    half = (len(phi_edges_deg) - 1) // 2
+    solid = np.diff(cos_edges)[:, None] * np.radians(np.diff(phi_edges_deg))[None, :]
+    lobe = energy / solid
+    return lobe[:, 0], lobe[:, half]
 
 
 def signed_angles(cos_edges):
-    """Outgoing polar angle of each cos bin's centre, in degrees: back side negative."""
+    """Outgoing polar angle of each cos bin's centre, in degrees: the light's side negative."""
     theta = np.degrees(np.arccos(0.5 * (cos_edges[:-1] + cos_edges[1:])))
     return -theta, theta
+
+
+def order_label(label):
+    """How `smithwalk plot` names an order slot ("all", "1", "3+" in `result.orders`)."""
+    if label == "all":
+        return "all orders"
+    return f"orders {label}" if label.endswith("+") else f"order {label}"
 
 
 def main():
@@ -59,36 +71,42 @@ def main():
     comparison = result.compare(MODELS)
     result.save(args.out / "run")
 
-    # Albedo per order: the walk against both models (all cases, reflection).
+    # Albedo per order: the walk against both models (all cases, reflection); order as in
+    # `result.orders` ("all", "1", "2", "3+").
     table = comparison.table
     columns = ["case", "model", "order", "albedo_measured", "albedo_measured_stderr", "albedo_model"]
-    print(table[table["hemisphere"] == "R"][columns].to_string(index=False))
+    reflected = table[table["hemisphere"] == "R"][columns].copy()
+    reflected["order"] = [result.orders[o] for o in reflected["order"]]
+    print(reflected.to_string(index=False))
 
-    orders = range(1, len(result.orders))  # slot 0 is all orders together
-    phi_bins = len(result.phi_edges_deg) - 1
+    rows = [*range(1, len(result.orders)), 0]  # orders 1, 2, ..., then all orders (slot 0)
     back_x, mirror_x = signed_angles(result.cos_edges)
     fig, axes = plt.subplots(
-        len(orders), len(result.cases), figsize=(3.2 * len(result.cases), 2.4 * len(orders)),
+        len(rows), len(result.cases), figsize=(3.2 * len(result.cases), 2.4 * len(rows)),
         squeeze=False, sharex=True,
     )
     for j, case in enumerate(result.cases):
-        for i, k in enumerate(orders):
+        for i, k in enumerate(rows):
             ax = axes[i, j]
-            walk = plane_of_incidence(result.bsdf[j, k, 0], phi_bins)
-            err = plane_of_incidence(result.bsdf_stderr[j, k, 0], phi_bins, stderr=True)
-            models = {m: plane_of_incidence(comparison[m]["bsdf"][j, k, 0], phi_bins) for m in MODELS}
+            walk = plane_of_incidence(result.energy[j, k, 0], result.cos_edges, result.phi_edges_deg)
+            err = plane_of_incidence(result.energy_stderr[j, k, 0], result.cos_edges, result.phi_edges_deg)
+            models = {
+                m: plane_of_incidence(comparison[m]["energy"][j, k, 0], result.cos_edges, result.phi_edges_deg)
+                for m in MODELS
+            }
             for side, x in enumerate((back_x, mirror_x)):
                 label = side == 1  # one legend entry per curve
                 ax.errorbar(x, walk[side], yerr=err[side], fmt=".", color="black", ms=3,
-                            label="walk" if label else None)
-                for m, color in zip(MODELS, ("tab:blue", "tab:orange")):
-                    ax.plot(x, models[m][side], color=color, lw=1, label=m if label else None)
+                            label="random walk (±1 SE)" if label else None)
+                for m in MODELS:
+                    colour, dash = MODEL_STYLE[m]
+                    ax.plot(x, models[m][side], color=colour, ls=dash, lw=1, label=m if label else None)
             if i == 0:
                 ax.set_title(f"alpha {case['alpha_x']}, theta_i {case['theta_i_deg']:g} deg", fontsize=9)
             if j == 0:
-                ax.set_ylabel(f"order {result.orders[k]}\nf (1/sr)")
-            if i == len(orders) - 1:
-                ax.set_xlabel("theta_o (deg), mirror side > 0")
+                ax.set_ylabel(f"{order_label(result.orders[k])}\nf·|cos θ_o| (1/sr)")
+            if i == len(rows) - 1:
+                ax.set_xlabel("θ_o (deg), + mirror side, − light's side")
     axes[0, 0].legend(fontsize=7)
     fig.tight_layout()
     args.out.mkdir(parents=True, exist_ok=True)

@@ -150,6 +150,14 @@ fn a_wrong_measurement_is_rejected_and_fails_the_gate() {
     let report = String::from_utf8_lossy(&bad.stdout);
     assert_eq!(bad.status.code(), Some(3), "{report}");
     assert!(report.contains("REJECTED by exact oracles: single"), "{report}");
+    // The worst lobes: a title line, a header that names every column, and the worst (rejected)
+    // lobe says so in the last column, under `verdict`.
+    let lines: Vec<&str> = report.lines().collect();
+    let title = lines.iter().position(|l| l.ends_with("lobes with the lowest p, worst first:")).expect(&report);
+    let (header, worst) = (lines[title + 1], lines[title + 2]);
+    let columns = ["case", "order", "hemi", "ch", "chi2", "dof", "p", "rel", "L1", "rel", "L2", "albedo", "diff"];
+    assert_eq!(header.split_whitespace().collect::<Vec<_>>(), [&columns[..], &["verdict"]].concat(), "{report}");
+    assert!(worst.ends_with("rejected") && header.find("verdict") == worst.rfind("rejected"), "{header}\n{worst}");
     let compare = rows(&format!("{out}/compare.csv"));
     assert!(compare.iter().all(|r| r["family_level"] == "0.01"));
     assert!(compare.iter().any(|r| r["rejected"] == "true"));

@@ -67,6 +67,9 @@ fn plot_writes_every_figure_and_a_report_that_shows_them() {
     assert_eq!(html.matches("<figcaption>").count(), pngs.len());
     // Columns constant over the run go into the header line, not the case tables.
     assert!(html.contains("ndf ggx") && !html.contains("<th>ndf</th>"), "constant columns in the header");
+    // Transmitted lobes state their own convention: theta_o from -z, the refraction side positive.
+    assert_eq!(html.matches("measured from −z (positive on the refraction side").count(), 2, "T captions");
+    assert_eq!(html.matches("measured from +z (positive on the mirror side").count(), 4, "R captions");
     assert!(html.contains("<th>theta_i_deg</th>") && html.contains("<th>alpha_x</th>"));
     // The comparison: per model its lobes and verdict, and the worst lobes.
     assert!(html.contains("Models: single, wang-correlated."), "the header names the models");
@@ -118,7 +121,12 @@ fn svg_output_goes_to_another_directory_with_vector_text() {
     assert!(!dir.path().join("index.html").exists(), "--out leaves the run directory alone");
     let lobes = std::fs::read_to_string(out.join("lobes_g0_R.svg")).unwrap();
     assert!(lobes.starts_with("<svg") && lobes.trim_end().ends_with("</svg>"));
-    assert!(lobes.contains("f·|cos θ_o| (1/sr)") && lobes.contains("θ_o (deg), + mirror side"), "axis labels as text");
+    assert!(
+        lobes.contains("f·|cos θ_o| (1/sr)") && lobes.contains("θ_o from +z (deg): + mirror side"),
+        "axis labels as text"
+    );
+    let transmitted = std::fs::read_to_string(out.join("lobes_g1_T.svg")).unwrap();
+    assert!(transmitted.contains("θ_o from −z (deg): + refraction side"), "T has its own axis label");
     // Heat maps are vector axes around an embedded raster.
     let heat = std::fs::read_to_string(out.join("heat_case0_R.svg")).unwrap();
     assert!(heat.contains("data:image/png;base64,") && heat.contains("f (1/sr)"));

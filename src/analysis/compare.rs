@@ -864,10 +864,11 @@ fn report(
         }
         let mut mine: Vec<&LobeComparison> = comparisons.iter().filter(|c| c.model == v.model).collect();
         mine.sort_by(|a, b| a.test.p_value.total_cmp(&b.test.p_value));
+        let _ = writeln!(out, "  its {} lobes with the lowest p, worst first:", mine.len().min(5));
         let _ = writeln!(
             out,
-            "  {:>5} {:>5} {:>4} {:>3} {:>10} {:>6} {:>10} {:>8} {:>8} {:>11}  worst first",
-            "case", "order", "hemi", "ch", "chi2", "dof", "p", "rel L1", "rel L2", "albedo diff"
+            "  {:>5} {:>5} {:>4} {:>3} {:>10} {:>6} {:>10} {:>8} {:>8} {:>11}  {}",
+            "case", "order", "hemi", "ch", "chi2", "dof", "p", "rel L1", "rel L2", "albedo diff", "verdict"
         );
         for c in mine.iter().take(5) {
             let order = if folded == Some(c.lobe.1) { format!("{}+", c.lobe.1) } else { c.lobe.1.to_string() };

@@ -2,14 +2,14 @@
 //! one panel per combination of the other parameters and hemisphere, one line with markers and
 //! one-standard-error bars per order slot, and one legend for the whole figure.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::style::{self, CAPTION, FONT, Figure, Key, TICK, draw_err};
-use super::{Points, Selection, groups, pretty_fields, slot_label};
+use super::{Points, Row, Selection, bar_top, folded_note, groups, pretty_fields, row_label};
 use crate::io::rundir::{RunDir, SummaryRow};
 use crate::setup::cases::Case;
 
@@ -59,19 +59,53 @@ impl Sweep {
     }
 }
 
-/// One panel: its caption and per order slot the points (x, albedo, standard error).
+/// One panel: its caption and per row (an index into the figure's rows) the points (x, albedo,
+/// standard error).
 type Panel = (String, BTreeMap<usize, Points>);
+
+/// The style of a row: its slot's, the "K+" row's for a row the figure sums.
+fn order_style(row: Row) -> style::LineStyle {
+    match row {
+        Row::Slot(slot) | Row::From(slot) => style::order_style(slot),
+    }
+}
+
+/// The albedo and its standard error of a row of one case, from the case's albedos per order
+/// slot: a slot's own, or for `From(k)` the sum over the slots from k up, exact, with a NaN
+/// standard error when it sums more than one slot (summary.csv has no covariances between
+/// orders); `None` where the case has none of them.
+fn row_albedo(orders: &BTreeMap<usize, (f64, f64)>, row: Row) -> Option<(f64, f64)> {
+    match row {
+        Row::Slot(slot) => orders.get(&slot).copied(),
+        Row::From(k) => {
+            let terms: Vec<(f64, f64)> = orders.range(k..).map(|(_, &v)| v).collect();
+            match terms[..] {
+                [] => None,
+                [one] => Some(one),
+                _ => Some((terms.iter().map(|t| t.0).sum(), f64::NAN)),
+            }
+        }
+    }
+}
 
 pub struct AlbedoFigure<'a> {
     run: &'a RunDir,
     sweep: Sweep,
     selection: Selection,
+    rows: &'a [Row],
     panels: Vec<Panel>,
 }
 
 impl<'a> AlbedoFigure<'a> {
-    /// The figure of `sweep`, or `None` when no panel has two values of the swept parameter.
-    pub fn new(run: &'a RunDir, summary: &[SummaryRow], sweep: Sweep, selection: Selection) -> Option<Self> {
+    /// The figure of `sweep` with the order rows `rows`, or `None` when no panel has two values
+    /// of the swept parameter.
+    pub fn new(
+        run: &'a RunDir,
+        summary: &[SummaryRow],
+        sweep: Sweep,
+        selection: Selection,
+        rows: &'a [Row],
+    ) -> Option<Self> {
         let channel = selection.channel_name();
         let groups = groups(run.cases.iter().filter(|c| sweep.takes(c)), sweep.columns());
         let mut group_of = vec![usize::MAX; run.cases.len()];
@@ -85,16 +119,21 @@ impl<'a> AlbedoFigure<'a> {
         let mut panels = Vec::new();
         for (g, cases) in groups.iter().enumerate() {
             for hemisphere in ["R", "T"] {
-                let mut orders: BTreeMap<usize, Points> = BTreeMap::new();
-                let rows = summary.iter().filter(|r| {
+                // Per case, its albedos per order slot.
+                let mut albedos: BTreeMap<usize, BTreeMap<usize, (f64, f64)>> = BTreeMap::new();
+                let found = summary.iter().filter(|r| {
                     group_of.get(r.case) == Some(&g) && r.hemisphere == hemisphere && r.channel.as_deref() == channel
                 });
-                for row in rows {
-                    orders.entry(row.order).or_default().push((
-                        sweep.x(&run.cases[row.case]),
-                        row.albedo,
-                        row.albedo_stderr,
-                    ));
+                for r in found {
+                    albedos.entry(r.case).or_default().insert(r.order, (r.albedo, r.albedo_stderr));
+                }
+                let mut orders: BTreeMap<usize, Points> = BTreeMap::new();
+                for (case, slots) in &albedos {
+                    for (i, &row) in rows.iter().enumerate() {
+                        if let Some((albedo, stderr)) = row_albedo(slots, row) {
+                            orders.entry(i).or_default().push((sweep.x(&run.cases[*case]), albedo, stderr));
+                        }
+                    }
                 }
                 if orders.is_empty() {
                     continue;
@@ -112,19 +151,18 @@ impl<'a> AlbedoFigure<'a> {
             }
         }
         let longest = panels.iter().flat_map(|p| p.1.values()).map(Vec::len).max().unwrap_or(0);
-        (longest >= 2).then_some(Self { run, sweep, selection, panels })
+        (longest >= 2).then_some(Self { run, sweep, selection, rows, panels })
+    }
+
+    /// The legend: the rows drawn in some panel, in plotting order.
+    fn legend(&self) -> Vec<(Key, String)> {
+        let drawn: BTreeSet<usize> = self.panels.iter().flat_map(|p| p.1.keys().copied()).collect();
+        drawn.into_iter().map(|i| (Key::Line(order_style(self.rows[i])), row_label(self.run, self.rows[i]))).collect()
     }
 
     fn grid(&self) -> (usize, usize) {
         let cols = self.panels.len().clamp(1, MAX_COLUMNS);
         (cols, self.panels.len().div_ceil(cols))
-    }
-
-    fn slots(&self) -> Vec<usize> {
-        let mut slots: Vec<usize> = self.panels.iter().flat_map(|p| p.1.keys().copied()).collect();
-        slots.sort_by_key(|&s| if s == 0 { usize::MAX } else { s });
-        slots.dedup();
-        slots
     }
 
     /// What the report says under the figure.
@@ -136,7 +174,8 @@ impl<'a> AlbedoFigure<'a> {
         format!(
             "Albedo per bounce order (the fraction of the incident energy that leaves in the hemisphere after exactly \
              that many bounces; \"all orders\" is their sum) against {x}, one panel per surface, material and \
-             hemisphere. Bars: ±1 standard error (most are smaller than the markers).{}",
+             hemisphere. Bars: ±1 standard error (most are smaller than the markers).{}{}",
+            folded_note(self.rows, true),
             self.selection.note()
         )
     }
@@ -145,7 +184,7 @@ impl<'a> AlbedoFigure<'a> {
         let xs = orders.values().flatten().map(|p| p.0);
         let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
         let pad = 0.05 * (hi - lo).max(1e-9);
-        let top = orders.values().flatten().map(|p| p.1 + p.2).fold(0.0_f64, f64::max).max(1e-9) * 1.08;
+        let top = orders.values().flatten().map(bar_top).fold(0.0_f64, f64::max).max(1e-9) * 1.08;
         let (x_decimals, y_decimals) = (style::tick_decimals(lo - pad, hi + pad, 6), style::tick_decimals(0.0, top, 5));
         let mut chart = ChartBuilder::on(area)
             .caption(caption, (FONT, CAPTION))
@@ -166,15 +205,15 @@ impl<'a> AlbedoFigure<'a> {
             .y_label_formatter(&|v| style::tick(*v, y_decimals))
             .draw()
             .map_err(draw_err)?;
-        for slot in self.slots() {
-            let Some(points) = orders.get(&slot) else { continue };
-            let line = style::order_style(slot);
+        for (i, points) in orders {
+            let line = order_style(self.rows[*i]);
             let curve: Vec<(f64, f64)> = points.iter().map(|p| (p.0, p.1)).collect();
             style::draw_line(chart.plotting_area(), &curve, line)?;
             chart
                 .draw_series(
                     points
                         .iter()
+                        .filter(|p| p.2.is_finite())
                         .map(|&(x, y, e)| PathElement::new(vec![(x, y - e), (x, y + e)], line.colour.stroke_width(1))),
                 )
                 .map_err(draw_err)?;
@@ -188,7 +227,7 @@ impl<'a> AlbedoFigure<'a> {
 
 impl Figure for AlbedoFigure<'_> {
     fn size(&self) -> (u32, u32) {
-        style::grid_size(PANEL, self.grid())
+        style::grid_size(PANEL, self.grid(), &self.legend())
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
@@ -197,12 +236,29 @@ impl Figure for AlbedoFigure<'_> {
             Sweep::Alpha => "Albedo per bounce order against the roughness",
         };
         let title = format!("{title}{}", self.selection.suffix());
-        let legend: Vec<(Key, String)> =
-            self.slots().into_iter().map(|s| (Key::Line(style::order_style(s)), slot_label(self.run, s))).collect();
+        let legend = self.legend();
         let labels = style::GridLabels { title: &title, legend: &legend, y: "albedo", x: self.sweep.axis() };
         for (area, panel) in style::draw_grid(root, &labels, self.grid())?.iter().zip(&self.panels) {
             self.panel(area, panel)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A summed row adds the albedos of its orders; its standard error is NaN unless it holds
+    /// one order only.
+    #[test]
+    fn a_summed_row_adds_the_albedos_of_its_orders() {
+        let orders: BTreeMap<usize, (f64, f64)> =
+            [(0, (0.9, 0.01)), (3, (0.1, 0.01)), (4, (0.05, 0.002)), (6, (0.01, 0.001))].into();
+        let (albedo, stderr) = row_albedo(&orders, Row::From(4)).unwrap();
+        assert!((albedo - 0.06).abs() < 1e-15 && stderr.is_nan());
+        assert_eq!(row_albedo(&orders, Row::From(6)), Some((0.01, 0.001)));
+        assert_eq!(row_albedo(&orders, Row::From(7)), None);
+        assert_eq!(row_albedo(&orders, Row::Slot(3)), Some((0.1, 0.01)));
     }
 }

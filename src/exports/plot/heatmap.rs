@@ -18,7 +18,7 @@ use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 
 use super::style::{self, CAPTION, FONT, Figure, LABEL, TICK, TITLE, draw_err};
-use super::{Selection, slot_label, surface_label};
+use super::{Row, Selection, highest_slot, row_bins, row_label, surface_label};
 use crate::engine::detector::Grid;
 use crate::io::rundir::{BinValue, Lobes, RunDir};
 use crate::setup::cases::Case;
@@ -40,7 +40,7 @@ pub struct HeatFigure<'a> {
     pub hemisphere: &'a str,
     pub selection: Selection,
     pub measured: &'a Lobes,
-    pub slots: &'a [usize],
+    pub rows: &'a [Row],
 }
 
 /// A panel's colour scale: values in `range` (of f, or of log10 f) map to 0..1.
@@ -101,13 +101,17 @@ fn colour(level: f64) -> RGBColor {
 }
 
 impl HeatFigure<'_> {
-    fn panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, slot: usize, log: bool) -> Result<()> {
+    fn panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, row: Row, log: bool) -> Result<()> {
         let ch = self.selection.channel;
-        let Some(bins) = self.measured.get(self.case.index, slot, self.hemisphere, ch) else { return Ok(()) };
+        let highest = highest_slot(self.measured, self.case.index, self.hemisphere, ch);
+        let Some(bins) = row_bins(self.measured, row, (self.case.index, self.hemisphere, ch), highest) else {
+            return Ok(());
+        };
+        let bins = &bins[..];
         let scale = Scale::of(bins, log);
         let (caption, area) = area.split_vertically(CAPTION_HEIGHT);
         let (w, _) = caption.dim_in_pixel();
-        let label = if log { format!("{}, log scale", slot_label(self.run, slot)) } else { slot_label(self.run, slot) };
+        let label = if log { format!("{}, log scale", row_label(self.run, row)) } else { row_label(self.run, row) };
         style::draw_centred(&caption, &label, ((w - BAR) as i32 / 2, 14), CAPTION, false)?;
         let (map_area, bar_area) = area.split_horizontally(PANEL.0 - BAR);
         // A square plotting area, so that the disc is round.
@@ -232,8 +236,8 @@ impl Figure for HeatFigure<'_> {
         style::draw_centred(root, &title, (width as i32 / 2, TOP as i32 / 2), TITLE - 2, false)?;
         let (cols, rows) = self.grid();
         let panels = root.margin(TOP, 0, 0, 0).split_evenly((rows, cols));
-        for (area, &slot) in panels.iter().zip(self.slots) {
-            self.panel(area, slot, self.selection.log)?;
+        for (area, &row) in panels.iter().zip(self.rows) {
+            self.panel(area, row, self.selection.log)?;
         }
         Ok(())
     }
@@ -255,17 +259,18 @@ impl HeatFigure<'_> {
         format!(
             "Case {} ({}, θ_i = {:.1}°), {hemisphere}: the BSDF f (1/sr) per bounce order over the projected hemisphere, \
              x = sin θ_o cos φ_o, y = sin θ_o sin φ_o with φ_o from the incident azimuth (the light comes from +x{mirror}). \
-             Each pixel is interpolated between the centres of the detector bins around its direction (linearly in |cos θ_o| and φ_o; at the pole, the mean of the innermost ring), on {scale}.{}",
+             Each pixel is interpolated between the centres of the detector bins around its direction (linearly in |cos θ_o| and φ_o; at the pole, the mean of the innermost ring), on {scale}.{}{}",
             self.case.index,
             surface_label(self.case),
             self.case.theta_i_deg,
+            super::folded_note(self.rows, false),
             self.selection.note(),
         )
     }
 
     fn grid(&self) -> (usize, usize) {
-        let cols = self.slots.len().clamp(1, MAX_COLUMNS);
-        (cols, self.slots.len().div_ceil(cols).max(1))
+        let cols = self.rows.len().clamp(1, MAX_COLUMNS);
+        (cols, self.rows.len().div_ceil(cols).max(1))
     }
 }
 

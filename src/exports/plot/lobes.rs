@@ -10,9 +10,12 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::style::{self, CAPTION, FONT, Figure, Key, MEASURED, TICK, draw_err};
-use super::{Points, Selection, plane_of_incidence, slot_label, surface_label};
-use crate::io::rundir::{Lobes, RunDir};
+use super::{
+    Points, Row, Selection, bar_top, folded_note, highest_slot, plane_of_incidence, row_bins, row_label, surface_label,
+};
+use crate::io::rundir::{BinValue, Lobes, RunDir};
 use crate::setup::cases::Case;
+use crate::setup::config::IncidentSide;
 
 const PANEL: (u32, u32) = (330, 250);
 /// The most incident angles side by side before a sweep wraps into another block of rows.
@@ -25,7 +28,7 @@ pub struct LobeFigure<'a> {
     pub selection: Selection,
     pub measured: &'a Lobes,
     pub models: &'a BTreeMap<String, Lobes>,
-    pub slots: &'a [usize],
+    pub rows: &'a [Row],
 }
 
 /// Columns per block and blocks for `n` incident angles: as few blocks as possible of at
@@ -37,39 +40,41 @@ pub fn wrap(n: usize) -> (usize, usize) {
 
 impl LobeFigure<'_> {
     fn models_drawn(&self) -> Vec<&String> {
-        let ch = self.selection.channel;
         self.models
             .iter()
             .filter(|(_, lobes)| {
-                self.cases
-                    .iter()
-                    .any(|c| self.slots.iter().any(|&s| lobes.get(c.index, s, self.hemisphere, ch).is_some()))
+                self.cases.iter().any(|c| self.rows.iter().any(|&row| self.bins(lobes, c, row).is_some()))
             })
             .map(|(name, _)| name)
             .collect()
     }
 
-    fn panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, case: &Case, slot: usize) -> Result<()> {
+    /// The bins of a row of one case in `lobes` (the measurement or a model).
+    fn bins<'b>(&self, lobes: &'b Lobes, case: &Case, row: Row) -> Option<std::borrow::Cow<'b, [BinValue]>> {
         let ch = self.selection.channel;
-        let Some(bins) = self.measured.get(case.index, slot, self.hemisphere, ch) else { return Ok(()) };
-        let points = plane_of_incidence(self.run, bins);
+        let highest = highest_slot(self.measured, case.index, self.hemisphere, ch);
+        row_bins(lobes, row, (case.index, self.hemisphere, ch), highest)
+    }
+
+    fn panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, case: &Case, row: Row) -> Result<()> {
+        let Some(bins) = self.bins(self.measured, case, row) else { return Ok(()) };
+        let points = plane_of_incidence(self.run, &bins);
         let lines: Vec<(style::LineStyle, Points)> = self
             .models
             .iter()
             .filter_map(|(name, lobes)| {
-                lobes
-                    .get(case.index, slot, self.hemisphere, ch)
-                    .map(|b| (style::model_style_by_name(name), plane_of_incidence(self.run, b)))
+                self.bins(lobes, case, row)
+                    .map(|b| (style::model_style_by_name(name), plane_of_incidence(self.run, &b)))
             })
             .collect();
         let top = points
             .iter()
-            .map(|p| p.1 + p.2)
+            .map(bar_top)
             .chain(lines.iter().flat_map(|(_, l)| l.iter().map(|p| p.1)))
             .fold(0.0_f64, f64::max);
         let top = if top > 0.0 && top.is_finite() { 1.08 * top } else { 1.0 };
         let decimals = style::tick_decimals(0.0, top, 5);
-        let caption = format!("{}, θ_i = {:.1}°", slot_label(self.run, slot), case.theta_i_deg);
+        let caption = format!("{}, θ_i = {:.1}°", row_label(self.run, row), case.theta_i_deg);
         let mut chart = ChartBuilder::on(area)
             .caption(caption, (FONT, CAPTION))
             .margin(6)
@@ -97,6 +102,7 @@ impl LobeFigure<'_> {
             .draw_series(
                 points
                     .iter()
+                    .filter(|p| p.2.is_finite())
                     .map(|&(x, y, e)| PathElement::new(vec![(x, y - e), (x, y + e)], MEASURED.stroke_width(1))),
             )
             .map_err(draw_err)?;
@@ -104,6 +110,18 @@ impl LobeFigure<'_> {
             .draw_series(points.iter().map(|&(x, y, _)| Circle::new((x, y), 2, MEASURED.filled())))
             .map_err(draw_err)?;
         Ok(())
+    }
+
+    /// The axis the hemisphere's θ_o is measured from: +z on the side of the light for R, the
+    /// other side for T (lobes.csv's `theta_o_deg` is from +z: θ_o is it or 180° minus it).
+    fn axis(&self) -> &'static str {
+        let below = (self.hemisphere == "T") == (self.cases[0].side == IncidentSide::Outside);
+        if below { "−z" } else { "+z" }
+    }
+
+    /// What the positive angles of the figure are: the mirror side in R, the refraction side in T.
+    fn positive_side(&self) -> &'static str {
+        if self.hemisphere == "T" { "refraction" } else { "mirror" }
     }
 
     /// What the report says under the figure.
@@ -116,46 +134,52 @@ impl LobeFigure<'_> {
             "Lines: the models of models.csv, each in its fixed colour and dash (docs/figures.md).".to_string()
         };
         format!(
-            "{}: the {hemisphere} lobe f·|cos θ_o| (1/sr) in the plane of incidence against the outgoing angle θ_o \
-             (positive on the mirror side, φ_o = 180°; negative on the light's side, φ_o = 0°), one row per bounce \
-             order and one column per incident angle θ_i. Black points: the random walk, each the average over a \
-             detector bin ({} bins in |cos θ_o|, {:.1}° of azimuth), with ±1 standard-error bars. {models}{}",
+            "{}: the {hemisphere} lobe f·|cos θ_o| (1/sr) in the plane of incidence against the outgoing angle θ_o, \
+             measured from {} (positive on the {} side, φ_o = 180°; negative on the light's side, φ_o = 0°), one \
+             row per bounce order and one column per incident angle θ_i. Black points: the random walk, each the \
+             average over a detector bin ({} bins in |cos θ_o|, {:.1}° of azimuth), with ±1 standard-error \
+             bars.{} {models}{}",
             surface_label(self.cases[0]),
+            self.axis(),
+            self.positive_side(),
             g.cos_bins,
             360.0 / g.phi_bins as f64,
+            folded_note(self.rows, true),
             self.selection.note(),
         )
     }
 
+    /// The legend: the walk's points and every model drawn.
+    fn legend(&self) -> Vec<(Key, String)> {
+        let mut legend = vec![(Key::Measured, "random walk (±1 SE)".to_string())];
+        legend.extend(self.models_drawn().into_iter().map(|m| (Key::Line(style::model_style_by_name(m)), m.clone())));
+        legend
+    }
+
     fn grid(&self) -> (usize, usize) {
         let (cols, blocks) = wrap(self.cases.len());
-        (cols, blocks * self.slots.len())
+        (cols, blocks * self.rows.len())
     }
 }
 
 impl Figure for LobeFigure<'_> {
     fn size(&self) -> (u32, u32) {
-        style::grid_size(PANEL, self.grid())
+        style::grid_size(PANEL, self.grid(), &self.legend())
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
         let hemisphere = if self.hemisphere == "T" { "transmission (T)" } else { "reflection (R)" };
         let title = format!("{}: {hemisphere}{}", surface_label(self.cases[0]), self.selection.suffix());
-        let mut legend = vec![(Key::Measured, "random walk (±1 SE)".to_string())];
-        legend.extend(self.models_drawn().into_iter().map(|m| (Key::Line(style::model_style_by_name(m)), m.clone())));
-        let labels = style::GridLabels {
-            title: &title,
-            legend: &legend,
-            y: "f·|cos θ_o| (1/sr)",
-            x: "θ_o (deg), + mirror side, − light's side (plane of incidence)",
-        };
+        let legend = self.legend();
+        let x = format!("θ_o from {} (deg): + {} side, − light's side", self.axis(), self.positive_side());
+        let labels = style::GridLabels { title: &title, legend: &legend, y: "f·|cos θ_o| (1/sr)", x: &x };
         let (cols, rows) = self.grid();
         let panels = style::draw_grid(root, &labels, (cols, rows))?;
         for (i, case) in self.cases.iter().enumerate() {
             let (block, col) = (i / cols, i % cols);
-            for (r, &slot) in self.slots.iter().enumerate() {
-                let row = block * self.slots.len() + r;
-                self.panel(&panels[row * cols + col], case, slot)?;
+            for (r, &row) in self.rows.iter().enumerate() {
+                let at = (block * self.rows.len() + r) * cols + col;
+                self.panel(&panels[at], case, row)?;
             }
         }
         Ok(())

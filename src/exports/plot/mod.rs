@@ -16,6 +16,7 @@ mod lobes;
 mod report;
 pub mod style;
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -29,6 +30,11 @@ use crate::setup::cases::Case;
 
 /// Points of a curve with error bars: (x, y, standard error).
 type Points = Vec<(f64, f64, f64)>;
+
+/// The top of a point's error bar, or the point where it has none (a NaN standard error).
+fn bar_top(p: &(f64, f64, f64)) -> f64 {
+    p.1 + if p.2.is_finite() { p.2 } else { 0.0 }
+}
 
 /// What `smithwalk plot` draws and where.
 #[derive(Clone, Debug)]
@@ -73,24 +79,100 @@ impl Selection {
     }
 }
 
-/// The order slots a run has, in plotting order: 1, 2, ..., then 0 (all orders).
-fn slots(run: &RunDir, lobes: &Lobes) -> Vec<usize> {
-    let highest = lobes.lobes.keys().map(|k| k.1).max().unwrap_or(0);
-    let mut out: Vec<usize> = (1..=highest.min(4)).collect();
-    if highest > 4 {
-        // Only one slot beyond 3: the folded "K+" slot, or order 4 when nothing is folded.
-        out.pop();
-        out.push(run.config.detector.max_order.map_or(4, |k| k as usize).min(highest));
-    }
-    out.push(0);
+/// The most bounce-order rows a figure shows besides "all orders": orders 1 to 3 and a fourth
+/// row that holds the rest.
+const ORDER_ROWS: usize = 4;
+
+/// A row of the per-order figures (lobes, heat maps, albedos).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Row {
+    /// One order slot of the run as written: order k, the run's folded "K+" slot
+    /// (`max_order = K`), or 0 (all orders).
+    Slot(usize),
+    /// Orders k and higher, summed by the figure over the run's slots from k up (the run has
+    /// more orders than the figure has rows).
+    From(usize),
+}
+
+/// The rows of a run whose highest order slot is `highest`, in plotting order: 1, 2, ... up to
+/// [`ORDER_ROWS`], the last of them "K+" (the sum of every order from K up) when the run has
+/// more, then all orders.
+fn rows(highest: usize) -> Vec<Row> {
+    let mut out: Vec<Row> = if highest > ORDER_ROWS {
+        (1..ORDER_ROWS).map(Row::Slot).chain([Row::From(ORDER_ROWS)]).collect()
+    } else {
+        (1..=highest).map(Row::Slot).collect()
+    };
+    out.push(Row::Slot(0));
     out
 }
 
+/// The highest order slot of the lobes of one case, hemisphere and channel (0 if none).
+fn highest_slot(lobes: &Lobes, case: usize, hemisphere: &str, channel: usize) -> usize {
+    lobes.lobes.keys().filter(|k| k.0 == case && k.2 == hemisphere && k.3 == channel).map(|k| k.1).max().unwrap_or(0)
+}
+
+/// The bins of `row` for one case, hemisphere and channel of `lobes` (the measurement or a
+/// model), or `None` where `lobes` lacks the lobe. A row `From(k)` sums the slots k to `highest`
+/// (the measurement's highest slot of the case), all of which `lobes` must have: energies and
+/// BSDF values exactly; its standard errors are NaN (no error bar) when it sums more than one
+/// slot, since one photon's energy in one bin can come from several orders (Fresnel splitting)
+/// and lobes.csv has no covariances between orders.
+fn row_bins<'a>(
+    lobes: &'a Lobes,
+    row: Row,
+    (case, hemisphere, channel): (usize, &str, usize),
+    highest: usize,
+) -> Option<Cow<'a, [BinValue]>> {
+    match row {
+        Row::Slot(slot) => lobes.get(case, slot, hemisphere, channel).map(Cow::Borrowed),
+        Row::From(k) if highest == k => lobes.get(case, k, hemisphere, channel).map(Cow::Borrowed),
+        Row::From(k) => {
+            let slots = (k..=highest).map(|s| lobes.get(case, s, hemisphere, channel)).collect::<Option<Vec<_>>>()?;
+            let mut sum = vec![
+                BinValue { energy_stderr: f64::NAN, bsdf_stderr: f64::NAN, ..BinValue::default() };
+                slots.first()?.len()
+            ];
+            for bins in slots {
+                for (total, b) in sum.iter_mut().zip(bins) {
+                    total.energy += b.energy;
+                    total.bsdf += b.bsdf;
+                }
+            }
+            Some(Cow::Owned(sum))
+        }
+    }
+}
+
+/// What a caption says about a row the figure sums (empty without one), and with `bars`, why
+/// that row has none.
+fn folded_note(rows: &[Row], bars: bool) -> String {
+    let Some(k) = rows.iter().find_map(|r| if let Row::From(k) = r { Some(k) } else { None }) else {
+        return String::new();
+    };
+    let why = if bars {
+        ", without error bars: lobes.csv and summary.csv have no covariances between orders (docs/figures.md)"
+    } else {
+        ""
+    };
+    format!(" \"orders {k}+\" is the sum of the run's orders {k} and higher{why}.")
+}
+
+/// How an order slot reads in figures and tables: "order k", "orders K+" for the run's folded
+/// slot, "all orders" for slot 0.
 fn slot_label(run: &RunDir, slot: usize) -> String {
     match slot {
         0 => "all orders".into(),
         k if run.config.detector.max_order == Some(k as u32) => format!("orders {k}+"),
         k => format!("order {k}"),
+    }
+}
+
+/// How a row reads in figures: as its slot, or "orders K+" for a row the figure sums.
+fn row_label(run: &RunDir, row: Row) -> String {
+    match row {
+        Row::Slot(slot) => slot_label(run, slot),
+        Row::From(k) => format!("orders {k}+"),
     }
 }
 
@@ -212,12 +294,12 @@ pub fn plot(run_dir: &Path, options: &PlotOptions) -> Result<Vec<PathBuf>> {
     let measured = run.measured()?;
     let models: BTreeMap<String, Lobes> = run.models()?.into_iter().collect();
     let summary = run.summary()?;
-    let order_slots = slots(&run, &measured);
+    let order_rows = rows(measured.lobes.keys().map(|k| k.1).max().unwrap_or(0));
     let ext = options.format.extension();
 
     let mut albedos = Vec::new();
     for sweep in [albedo::Sweep::Theta, albedo::Sweep::Alpha] {
-        if let Some(figure) = albedo::AlbedoFigure::new(&run, &summary, sweep, selection) {
+        if let Some(figure) = albedo::AlbedoFigure::new(&run, &summary, sweep, selection, &order_rows) {
             albedos.push(Drawn {
                 name: format!("{}.{ext}", sweep.file_stem()),
                 bytes: style::render(&figure, options.format)?,
@@ -237,7 +319,7 @@ pub fn plot(run_dir: &Path, options: &PlotOptions) -> Result<Vec<PathBuf>> {
                 selection,
                 measured: &measured,
                 models: &models,
-                slots: &order_slots,
+                rows: &order_rows,
             };
             lobes.push(Drawn {
                 name: format!("lobes_g{g}_{hemisphere}.{ext}"),
@@ -251,7 +333,7 @@ pub fn plot(run_dir: &Path, options: &PlotOptions) -> Result<Vec<PathBuf>> {
                     hemisphere: &hemisphere,
                     selection,
                     measured: &measured,
-                    slots: &order_slots,
+                    rows: &order_rows,
                 };
                 heats.push((
                     case.index,
@@ -305,5 +387,41 @@ mod tests {
         assert!((lit[0].0 - expected_theta).abs() < 1e-12, "{:?}", lit[0]);
         // f |cos| = energy / (d|cos| dphi) = 0.1 / (0.25 * pi / 4).
         assert!((lit[0].1 - 0.1 / (0.25 * std::f64::consts::FRAC_PI_4)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn runs_with_more_than_four_orders_get_a_fourth_row_of_every_order_above_three() {
+        assert_eq!(rows(13), [Row::Slot(1), Row::Slot(2), Row::Slot(3), Row::From(4), Row::Slot(0)]);
+        assert_eq!(rows(5), rows(13));
+        assert_eq!(rows(4), [Row::Slot(1), Row::Slot(2), Row::Slot(3), Row::Slot(4), Row::Slot(0)]);
+        assert_eq!(rows(2), [Row::Slot(1), Row::Slot(2), Row::Slot(0)]);
+    }
+
+    /// The summed "4+" row of a run without `max_order` holds, bin by bin, the all-orders lobe
+    /// minus orders 1 to 3, in both hemispheres; its standard errors are NaN (not drawn).
+    #[test]
+    fn the_summed_row_is_all_orders_minus_the_orders_above_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let config = crate::setup::config::Config::parse(
+            "paths = 20000\nseed = 5\n[surface]\nalpha = 0.8\n[material]\nkind = \"dielectric\"\neta = 1.5\n[incident]\ntheta_deg = 60\nside = \"inside\"\n[detector]\ncos_theta_bins = 4\nphi_bins = 8\n",
+        )
+        .unwrap();
+        let sim = crate::engine::simulate(&config, Some(1), false).unwrap();
+        crate::io::output::write_outputs(&sim, &config, dir.path()).unwrap();
+        let run = RunDir::open(dir.path()).unwrap();
+        let measured = run.measured().unwrap();
+        for hemisphere in ["R", "T"] {
+            let highest = highest_slot(&measured, 0, hemisphere, 0);
+            assert!(highest > 5, "{hemisphere}: orders up to {highest} only");
+            assert_eq!(rows(highest)[3], Row::From(4));
+            let folded = row_bins(&measured, Row::From(4), (0, hemisphere, 0), highest).unwrap();
+            let slot = |s| measured.get(0, s, hemisphere, 0).unwrap();
+            for (i, b) in folded.iter().enumerate() {
+                let rest = slot(0)[i].energy - slot(1)[i].energy - slot(2)[i].energy - slot(3)[i].energy;
+                assert!((b.energy - rest).abs() <= 1e-12, "{hemisphere} bin {i}: {} against {rest}", b.energy);
+                assert!(b.energy_stderr.is_nan() && b.bsdf_stderr.is_nan());
+            }
+            assert!(folded.iter().map(|b| b.energy).sum::<f64>() > 0.0);
+        }
     }
 }

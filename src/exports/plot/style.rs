@@ -100,7 +100,7 @@ pub fn model_style_by_name(name: &str) -> LineStyle {
     Model::parse(name).map_or(line(GREY, Dash::Solid), model_style)
 }
 
-/// The style of an order slot (0 = all orders; `4` is also the "4+" slot) in the albedo
+/// The style of an order slot (0 = all orders; `4` is also the fourth row, "4+" or "K+") in the albedo
 /// figures: a colour, a dash and a marker each, so that the orders stay apart in grey print.
 pub fn order_style(slot: usize) -> LineStyle {
     let (colour, dash, marker) = match slot {
@@ -167,45 +167,78 @@ pub enum Key {
     Measured,
 }
 
-/// Draws a one-line legend centred in `area` (a band outside the panels), entries left to
-/// right.
-pub fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, entries: &[(Key, String)]) -> Result<()> {
+/// The distance between the lines of a legend that wraps.
+const LEGEND_LINE: u32 = 24;
+
+/// The width in pixels each legend entry takes: line sample, gap, text and the space to the
+/// next entry.
+fn legend_widths(entries: &[(Key, String)]) -> Vec<i32> {
     let font = (FONT, CAPTION).into_font();
-    let sample = 34;
-    let widths: Vec<i32> = entries
+    entries
         .iter()
         .map(|(_, name)| {
-            let (w, _) =
-                area.estimate_text_size(name, &TextStyle::from(font.clone())).unwrap_or((8 * name.len() as u32, 0));
-            sample + 6 + w as i32 + 24
+            let (w, _) = font.box_size(name).unwrap_or((8 * name.len() as u32, 0));
+            LEGEND_SAMPLE + 6 + w as i32 + 24
         })
-        .collect();
-    let (width, height) = area.dim_in_pixel();
-    let mut x = ((width as i32 - widths.iter().sum::<i32>()) / 2).max(4);
-    let y = height as i32 / 2;
-    for ((key, name), w) in entries.iter().zip(&widths) {
-        match key {
-            Key::Line(style) => {
-                draw_line(area, &[(x, y), (x + sample, y)], *style)?;
-                draw_marker(area, (x + sample / 2, y), *style)?;
-            }
-            Key::Measured => {
-                let c = (x + sample / 2, y);
-                area.draw(&PathElement::new(vec![(c.0, y - 8), (c.0, y + 8)], MEASURED.stroke_width(1)))
-                    .map_err(draw_err)?;
-                area.draw(&Circle::new(c, 3, MEASURED.filled())).map_err(draw_err)?;
-            }
+        .collect()
+}
+
+/// The length of a legend entry's line sample.
+const LEGEND_SAMPLE: i32 = 34;
+
+/// The legend's entries in lines that fit `width` pixels (at least one entry per line), each
+/// line as the range of its entries.
+fn legend_lines(entries: &[(Key, String)], width: u32) -> Vec<std::ops::Range<usize>> {
+    let mut lines = Vec::new();
+    let (mut start, mut used) = (0, 0);
+    for (i, w) in legend_widths(entries).into_iter().enumerate() {
+        if i > start && used + w > width as i32 - 8 {
+            lines.push(start..i);
+            (start, used) = (i, 0);
         }
-        let style =
-            font.clone().color(&BLACK).pos(text_anchor::Pos::new(text_anchor::HPos::Left, text_anchor::VPos::Center));
-        area.draw(&Text::new(name.clone(), (x + sample + 6, y), style)).map_err(draw_err)?;
-        x += w;
+        used += w;
+    }
+    lines.push(start..entries.len());
+    lines
+}
+
+/// Draws a legend centred in `area` (a band outside the panels), entries left to right, in as
+/// many lines as its width needs, [`LEGEND_LINE`] apart.
+pub fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, entries: &[(Key, String)]) -> Result<()> {
+    let font = (FONT, CAPTION).into_font();
+    let widths = legend_widths(entries);
+    let (width, height) = area.dim_in_pixel();
+    let lines = legend_lines(entries, width);
+    let first = height as i32 / 2 - (lines.len() as i32 - 1) * LEGEND_LINE as i32 / 2;
+    for (n, line) in lines.into_iter().enumerate() {
+        let mut x = ((width as i32 - widths[line.clone()].iter().sum::<i32>()) / 2).max(4);
+        let y = first + n as i32 * LEGEND_LINE as i32;
+        for ((key, name), w) in entries[line.clone()].iter().zip(&widths[line]) {
+            match key {
+                Key::Line(style) => {
+                    draw_line(area, &[(x, y), (x + LEGEND_SAMPLE, y)], *style)?;
+                    draw_marker(area, (x + LEGEND_SAMPLE / 2, y), *style)?;
+                }
+                Key::Measured => {
+                    let c = (x + LEGEND_SAMPLE / 2, y);
+                    area.draw(&PathElement::new(vec![(c.0, y - 8), (c.0, y + 8)], MEASURED.stroke_width(1)))
+                        .map_err(draw_err)?;
+                    area.draw(&Circle::new(c, 3, MEASURED.filled())).map_err(draw_err)?;
+                }
+            }
+            let style = font
+                .clone()
+                .color(&BLACK)
+                .pos(text_anchor::Pos::new(text_anchor::HPos::Left, text_anchor::VPos::Center));
+            area.draw(&Text::new(name.clone(), (x + LEGEND_SAMPLE + 6, y), style)).map_err(draw_err)?;
+            x += w;
+        }
     }
     Ok(())
 }
 
-/// Bands around a grid of panels: the title and the legend above, the y label shared by the
-/// grid on the left and the x label below.
+/// Bands around a grid of panels: the title and a one-line legend above (each further legend
+/// line adds [`LEGEND_LINE`]), the y label shared by the grid on the left and the x label below.
 const GRID_TOP: u32 = 78;
 const GRID_LEFT: u32 = 30;
 const GRID_BOTTOM: u32 = 34;
@@ -218,9 +251,15 @@ pub struct GridLabels<'a> {
     pub x: &'a str,
 }
 
+/// The height of the band above a grid `width` pixels wide: title and legend.
+fn grid_top(legend: &[(Key, String)], width: u32) -> u32 {
+    GRID_TOP + LEGEND_LINE * (legend_lines(legend, width).len() as u32 - 1)
+}
+
 /// The canvas size of a grid of `cols` x `rows` panels of `panel` pixels with its bands.
-pub fn grid_size(panel: (u32, u32), (cols, rows): (usize, usize)) -> (u32, u32) {
-    (GRID_LEFT + panel.0 * cols as u32, GRID_TOP + panel.1 * rows as u32 + GRID_BOTTOM)
+pub fn grid_size(panel: (u32, u32), (cols, rows): (usize, usize), legend: &[(Key, String)]) -> (u32, u32) {
+    let width = GRID_LEFT + panel.0 * cols as u32;
+    (width, grid_top(legend, width) + panel.1 * rows as u32 + GRID_BOTTOM)
 }
 
 /// Draws the title, the legend and the shared axis labels of a grid of panels, and returns
@@ -231,13 +270,14 @@ pub fn draw_grid<DB: DrawingBackend>(
     (cols, rows): (usize, usize),
 ) -> Result<Vec<DrawingArea<DB, Shift>>> {
     let (width, height) = root.dim_in_pixel();
+    let top = grid_top(labels.legend, width);
     draw_centred(root, labels.title, (width as i32 / 2, 18), TITLE, false)?;
-    draw_legend(&root.margin(38, 0, 0, 0).shrink((0, 0), (width, 36)), labels.legend)?;
-    let middle = (GRID_TOP + (height - GRID_TOP - GRID_BOTTOM) / 2) as i32;
+    draw_legend(&root.margin(38, 0, 0, 0).shrink((0, 0), (width, top - 42)), labels.legend)?;
+    let middle = (top + (height - top - GRID_BOTTOM) / 2) as i32;
     draw_centred(root, labels.y, (GRID_LEFT as i32 / 2, middle), LABEL, true)?;
     let below = ((GRID_LEFT + (width - GRID_LEFT) / 2) as i32, (height - GRID_BOTTOM / 2) as i32);
     draw_centred(root, labels.x, below, LABEL, false)?;
-    Ok(root.margin(GRID_TOP, GRID_BOTTOM, GRID_LEFT, 0).split_evenly((rows, cols)))
+    Ok(root.margin(top, GRID_BOTTOM, GRID_LEFT, 0).split_evenly((rows, cols)))
 }
 
 /// Draws a text centred at a pixel, turned by `rotate` (axis labels shared by a row or column
@@ -357,5 +397,23 @@ mod tests {
         assert_eq!(tick(0.0, 3), "0");
         assert_eq!(tick_decimals(-90.0, 90.0, 7), 0);
         assert!(tick_decimals(0.0, 0.0033, 5) >= 3);
+    }
+
+    #[test]
+    fn legends_wrap_into_lines_that_fit_the_figure() {
+        let entries: Vec<(Key, String)> = ["order 1", "order 2", "order 3", "orders 4+", "all orders"]
+            .iter()
+            .enumerate()
+            .map(|(i, name)| (Key::Line(order_style(i)), name.to_string()))
+            .collect();
+        assert_eq!(legend_lines(&entries, 1400), vec![std::ops::Range { start: 0, end: 5 }]);
+        let widths = legend_widths(&entries);
+        let lines = legend_lines(&entries, 390);
+        assert!(lines.len() > 1, "{lines:?}");
+        for line in &lines {
+            assert!(widths[line.clone()].iter().sum::<i32>() <= 390, "{line:?} of {widths:?}");
+        }
+        assert_eq!(lines.iter().map(|l| l.len()).sum::<usize>(), 5);
+        assert!(grid_size((360, 260), (1, 1), &entries).1 > grid_size((360, 260), (4, 1), &entries).1);
     }
 }
