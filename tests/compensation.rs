@@ -119,7 +119,7 @@ fn directional_albedo_matches_independent_values() {
         ] {
             for theta in [0.0f64, 50.0, 85.0] {
                 let c = case(ndf, alpha, theta, material.clone());
-                let bins: f64 = single_scattering_bins(&c, &GRID, Hemisphere::R, 1e-10).unwrap().iter().sum();
+                let bins: f64 = single_scattering_bins(&c, &GRID, Hemisphere::R, 0, 1e-10).unwrap().iter().sum();
                 let e = e_direct(ndf, alpha, theta.to_radians().cos(), f);
                 assert!((e - bins).abs() < 1e-8, "{ndf:?} alpha {alpha} theta {theta} {f:?}: E {e} vs bins {bins}");
             }
@@ -251,7 +251,7 @@ fn the_order_one_part_of_every_model_is_single_scattering() {
     for (ndf, alpha, theta) in [(NdfKind::Ggx, 0.5, 40.0), (NdfKind::Beckmann, 0.8, 70.0)] {
         for material in [conductor(FresnelKind::None, None), conductor(FresnelKind::Schlick, Some(0.3))] {
             let c = case(ndf, alpha, theta, material.clone());
-            let single = single_scattering_bins(&c, &GRID, Hemisphere::R, 1e-10).unwrap();
+            let single = single_scattering_bins(&c, &GRID, Hemisphere::R, 0, 1e-10).unwrap();
             let f = Fresnel::channels::<1>(&material).unwrap()[0];
             let (e, ef) = (e_table(ndf, alpha, Fresnel::One), e_table(ndf, alpha, f));
             let mu_i = theta.to_radians().cos();
@@ -279,7 +279,7 @@ fn the_order_one_part_of_every_model_is_single_scattering() {
         }
         // Turquin scales single scattering by 1 + F0 (...): with F0 = 0 nothing is added.
         let c = case(ndf, alpha, theta, conductor(FresnelKind::Schlick, Some(0.0)));
-        let single = single_scattering_bins(&c, &GRID, Hemisphere::R, 1e-10).unwrap();
+        let single = single_scattering_bins(&c, &GRID, Hemisphere::R, 0, 1e-10).unwrap();
         let model_bins = bins(Compensation::Turquin, &c, 1e-10, &mut AlbedoCache::default());
         for (b, s) in model_bins.iter().zip(&single) {
             assert!((b - s).abs() < 1e-9, "{b} vs {s}");
@@ -292,7 +292,7 @@ fn wrong_formulas_miss_the_exact_integrals() {
     // Kulla-Conty with E_avg in place of E(mu_i): the same bins and the same 2e-6 check.
     let (alpha, theta) = (1.0, 80.0);
     let c = case(NdfKind::Ggx, alpha, theta, conductor(FresnelKind::None, None));
-    let single: f64 = single_scattering_bins(&c, &GRID, Hemisphere::R, 1e-10).unwrap().iter().sum();
+    let single: f64 = single_scattering_bins(&c, &GRID, Hemisphere::R, 0, 1e-10).unwrap().iter().sum();
     let e = e_table(NdfKind::Ggx, alpha, Fresnel::One);
     let ms = |e_i: f64| -> f64 {
         gauss_legendre(64, 0.0, 1.0)

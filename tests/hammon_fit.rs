@@ -31,7 +31,7 @@ fn case(alpha: f64, f0: f64, albedo: f64, theta: f64) -> (Case, String) {
 fn smooth_limit_of_the_fit_is_normalized() {
     let grid = Grid { cos_bins: 16, phi_bins: 32 };
     let (c, _) = case(1e-4, 0.0, 1.0, 0.0);
-    let total: f64 = hammon_fit_bins(&c, &grid, HammonFitPart::Single, 1e-12).unwrap().iter().sum();
+    let total: f64 = hammon_fit_bins(&c, &grid, HammonFitPart::Single, 0, 1e-12).unwrap().iter().sum();
     // The alpha-weighted rough term and the Schlick specular of F0 = 0 near the mirror
     // direction add at most a few 1e-4.
     assert!((total - 1.0).abs() < 1e-3, "smooth-limit diffuse albedo {total}");
@@ -41,7 +41,7 @@ fn smooth_limit_of_the_fit_is_normalized() {
 fn the_fit_beside_the_simulation() {
     let (c, toml) = case(0.5, 0.02, 0.75, 30.0);
     let grid = Grid { cos_bins: 16, phi_bins: 32 };
-    let fit: f64 = hammon_fit_bins(&c, &grid, HammonFitPart::All, 1e-12).unwrap().iter().sum();
+    let fit: f64 = hammon_fit_bins(&c, &grid, HammonFitPart::All, 0, 1e-12).unwrap().iter().sum();
     let sim = smithwalk::simulate(&Config::parse(&toml).unwrap(), Some(2), false).unwrap();
     let e = smithwalk::io::output::EnergyBalance::from_result(&sim.results[0]);
     let measured = e.reflected[0];
@@ -87,8 +87,8 @@ fn the_fit_is_offered_only_for_isotropic_ggx_lit_from_outside() {
     let beckmann = Case { ndf: NdfKind::Beckmann, ..isotropic.clone() };
     let anisotropic = Case { alpha_y: 0.3, ..isotropic.clone() };
     let inside = Case { side: IncidentSide::Inside, ..isotropic.clone() };
-    assert!(hammon_fit_bins(&isotropic, &grid, HammonFitPart::All, 1e-6).is_some());
+    assert!(hammon_fit_bins(&isotropic, &grid, HammonFitPart::All, 0, 1e-6).is_some());
     for (label, c) in [("beckmann", beckmann), ("anisotropic", anisotropic), ("inside", inside)] {
-        assert!(hammon_fit_bins(&c, &grid, HammonFitPart::All, 1e-6).is_none(), "offered for {label}");
+        assert!(hammon_fit_bins(&c, &grid, HammonFitPart::All, 0, 1e-6).is_none(), "offered for {label}");
     }
 }

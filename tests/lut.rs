@@ -41,7 +41,7 @@ fn single_albedo(case: &Case, hemisphere: Hemisphere) -> f64 {
         "hammon" | "diffuse" => Grid { cos_bins: 16, phi_bins: 32 },
         _ => Grid { cos_bins: 1, phi_bins: 1 },
     };
-    single_scattering_bins(case, &grid, hemisphere, 1e-9).expect("single scattering applies").iter().sum()
+    single_scattering_bins(case, &grid, hemisphere, 0, 1e-9).expect("single scattering applies").iter().sum()
 }
 
 /// The two-sided z threshold of one of `cells` tests at Sidak family level 0.01.

@@ -1,10 +1,11 @@
 //! `models.csv` is `lobes.csv`'s rows with the models' values beside them (issue 15.4,
 //! docs/compare.md): row for row the same key columns as `lobes.csv` (mono and RGB runs), then
 //! per model compared, in that order, `<model>` and `<model>_stderr`, empty exactly where the
-//! model gives no lobe (`single` outside order 1 and on the g and b channels, closed-form models'
-//! standard errors 0, `exact-position-free` outside one-sided facets), finite and non-negative
-//! elsewhere; a model lobe of a slot the run has no light in is not written. Readers find the
-//! models by the header and refuse a models.csv whose rows are not those of lobes.csv.
+//! model gives no lobe (`single` outside order 1, closed-form models' standard errors 0,
+//! `exact-position-free` outside one-sided facets), finite and non-negative elsewhere, and the
+//! closed-form models on every channel of RGB runs, each with its own parameters; a model lobe
+//! of a slot the run has no light in is not written. Readers find the models by the header and
+//! refuse a models.csv whose rows are not those of lobes.csv.
 //!
 //! Small runs (8 x 16 bins, fixed seeds); nothing here is statistical.
 
@@ -143,18 +144,30 @@ fn a_mono_run_has_the_rows_of_lobes_csv_and_a_cell_per_model_where_it_applies() 
 }
 
 #[test]
-fn an_rgb_run_has_the_rows_of_lobes_csv_with_closed_form_models_on_channel_r_only() {
+fn an_rgb_run_has_the_rows_of_lobes_csv_with_closed_form_models_on_every_channel() {
     let dir = tempfile::tempdir().unwrap();
     let models = [Model::HammonFit, Model::HeitzNee, Model::Single];
     let (_, table) = compared(dir.path(), RGB, &models, 5_000);
     let (order, channel, folded) =
         (table.column("order").unwrap(), table.column("channel").unwrap(), table.column("folded").unwrap());
     for (r, e, se) in cells(&table, "single") {
-        assert_eq!(!e.is_empty(), r[order] == "1" && r[channel] == "r", "{r:?}");
+        assert_eq!(!e.is_empty(), r[order] == "1", "{r:?}");
         assert!(se.is_empty() || se == "0");
     }
     for (r, e, _) in cells(&table, "hammon-fit") {
-        assert_eq!(!e.is_empty(), r[order] != "2" && r[channel] == "r", "orders 0 and 1 only: {r:?}");
+        assert_eq!(!e.is_empty(), r[order] != "2", "orders 0 and 1 only: {r:?}");
+    }
+    // Each channel with its own albedo (0.9, 0.5, 0.1): the rows of a bin come r, g, b, and
+    // the closed-form models' values fall with the albedo wherever the bin has light.
+    for model in ["single", "hammon-fit"] {
+        let values: Vec<(&str, &str)> = cells(&table, model).map(|(r, e, _)| (r[channel].as_str(), e)).collect();
+        let rgb: Vec<&[(&str, &str)]> = values.chunks(3).filter(|c| !c[0].1.is_empty()).collect();
+        assert!(!rgb.is_empty());
+        for c in rgb {
+            assert_eq!(c.iter().map(|v| v.0).collect::<Vec<_>>(), ["r", "g", "b"]);
+            let [r, g, b] = [0, 1, 2].map(|i| c[i].1.parse::<f64>().unwrap());
+            assert!(r == 0.0 || (r > g && g > b), "{model}: channels r, g, b {c:?}");
+        }
     }
     assert!(cells(&table, "heitz-nee").all(|(_, e, _)| !e.is_empty()), "heitz-nee gives every channel");
     for r in &table.rows {

@@ -11,21 +11,25 @@
 //! * Albedo: at 10^7 photons the order-1 albedo of the GGX conductor with F = 1 is compared
 //!   with the quadrature values of docs/theory.md §9.4 (independent scripts; 1 - ln 2 in closed
 //!   form at alpha 1, normal incidence), within 4 standard errors (SE about 1.5e-4).
+//! * RGB runs (a Schlick conductor, gold, Lambertian facets, each channel its own parameters):
+//!   every channel's order-1 histogram against the model of that channel, and the conductors'
+//!   order-1 albedos against the integral over the visible normals; channel r's model is
+//!   rejected on g and b.
 //! * The model itself: on nearly smooth surfaces its bins' sum against the order-1 albedo
 //!   integrated over the visible normals instead of the outgoing directions, and it is offered
 //!   only for the walk it describes (true Smith Lambda, visible normals, light from outside).
 
 mod common;
 
-use common::{albedo, mono, simulate, two_sided_z, weighted_bins};
+use common::{albedo, channel_albedo, channel_bins, mono, rgb, simulate, two_sided_z, weighted_bins};
 use numerics::quadrature::integrate_2d;
 use smithwalk::analysis::models::{single_scattering_bins, single_scattering_lobe};
 use smithwalk::analysis::stats::{ChiSquare, chi_square, sidak};
-use smithwalk::engine::detector::{Detector, Grid, Hemisphere};
+use smithwalk::engine::detector::{Grid, Hemisphere};
 use smithwalk::microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 use smithwalk::microsurface::{DVec3, fresnel, single};
 use smithwalk::setup::cases::{Case, expand};
-use smithwalk::setup::config::Config;
+use smithwalk::setup::config::{Config, MaterialConfig};
 use std::f64::consts::TAU;
 
 /// The one case of a one-case TOML config.
@@ -86,19 +90,11 @@ const CASES: [HistogramCase; 6] = [
     },
 ];
 
-/// Beside a chi-square `test` of the order-1 histogram on `hemisphere` against `expected`: it
-/// kept at least 16 cells (a lobe wrongly expected to be zero almost everywhere pools into one
-/// untested cell), and the order-1 albedo matches the bins' sum by a z test at `level`.
-fn assert_cells_and_albedo(
-    d: &Detector<1>,
-    hemisphere: Hemisphere,
-    test: &ChiSquare,
-    expected: &[f64],
-    level: f64,
-    label: &str,
-) {
+/// Beside a chi-square `test` of an order-1 histogram against `expected`: it kept at least 16
+/// cells (a lobe wrongly expected to be zero almost everywhere pools into one untested cell),
+/// and the measured order-1 albedo `(e1, se)` matches the bins' sum by a z test at `level`.
+fn assert_cells_and_albedo((e1, se): (f64, f64), test: &ChiSquare, expected: &[f64], level: f64, label: &str) {
     assert!(test.dof >= 16, "{label}: only {} cells tested", test.dof);
-    let (e1, se) = albedo(d, 1, hemisphere);
     let total: f64 = expected.iter().sum();
     println!("{label}: E1 {e1:.5} +- {se:.5}, single scattering {total:.5}");
     assert!((e1 - total).abs() < two_sided_z(level) * se, "{label}: E1 = {e1} +- {se}, single scattering {total}");
@@ -120,9 +116,9 @@ fn order_one_histograms_match_single_scattering() {
         let sim = simulate(&toml, 2);
         let d = mono(&sim, 0);
         for &h in c.hemispheres {
-            let expected = single_scattering_bins(&sim.cases[0], &d.grid, h, 1e-10).expect("closed form applies");
+            let expected = single_scattering_bins(&sim.cases[0], &d.grid, h, 0, 1e-10).expect("closed form applies");
             let test = chi_square(&weighted_bins(d, 1, h), &expected, d.tallies.photons, 5.0);
-            assert_cells_and_albedo(d, h, &test, &expected, level, &format!("case {i} {h:?}"));
+            assert_cells_and_albedo(albedo(d, 1, h), &test, &expected, level, &format!("case {i} {h:?}"));
             assert!(
                 test.p_value > level,
                 "case {i} ({} / {} at {} deg) {h:?}: order-1 histogram rejected\n{}",
@@ -165,7 +161,7 @@ fn a_wrong_lobe_is_rejected() {
     other.alpha_x = 0.55;
     other.alpha_y = 0.55;
     let d = mono(&sim, 0);
-    let expected = single_scattering_bins(&other, &d.grid, Hemisphere::R, 1e-10).unwrap();
+    let expected = single_scattering_bins(&other, &d.grid, Hemisphere::R, 0, 1e-10).unwrap();
     let test = chi_square(&weighted_bins(d, 1, Hemisphere::R), &expected, d.tallies.photons, 5.0);
     assert!(test.p_value < 1e-6, "p = {}", test.p_value);
 }
@@ -215,14 +211,14 @@ fn order_one_of_scattering_facets_matches_single_scattering() {
         );
         let sim = simulate(&toml, 2);
         let d = mono(&sim, 0);
-        let expected = single_scattering_bins(&sim.cases[0], &d.grid, Hemisphere::R, 1e-9).expect("true Smith");
+        let expected = single_scattering_bins(&sim.cases[0], &d.grid, Hemisphere::R, 0, 1e-9).expect("true Smith");
         let test = chi_square(&weighted_bins(d, 1, Hemisphere::R), &expected, d.tallies.photons, 5.0);
         println!(
             "{material} {alpha} at {theta} deg: chi2 {:.1}, dof {}, p {:.3e}",
             test.statistic, test.dof, test.p_value
         );
         let label = format!("{material} {alpha} at {theta} deg");
-        assert_cells_and_albedo(d, Hemisphere::R, &test, &expected, level, &label);
+        assert_cells_and_albedo(albedo(d, 1, Hemisphere::R), &test, &expected, level, &label);
         assert!(test.p_value > level, "{material} {alpha} at {theta} deg: order 1 rejected\n{}", test.worst_cells(10));
     }
 }
@@ -239,7 +235,7 @@ fn lambertian_single_scattering_albedo_matches_the_formula_values() {
             "paths = 10\n[surface]\nalpha = {alpha}\n[material]\nkind = \"diffuse\"\n[incident]\ntheta_deg = {theta}\n"
         );
         let case = case_of(&toml);
-        let e1: f64 = single_scattering_bins(&case, &grid, Hemisphere::R, 1e-9).unwrap().iter().sum();
+        let e1: f64 = single_scattering_bins(&case, &grid, Hemisphere::R, 0, 1e-9).unwrap().iter().sum();
         assert!((e1 - reference).abs() < 2e-3, "alpha {alpha} theta {theta}: E1 = {e1}, formula {reference}");
     }
 }
@@ -256,27 +252,41 @@ fn single_scattering_is_offered_only_where_it_is_order_one_of_the_walk() {
         );
         case_of(&toml)
     };
-    assert!(single_scattering_bins(&case("", ""), &grid, Hemisphere::R, 1e-6).is_some());
+    assert!(single_scattering_bins(&case("", ""), &grid, Hemisphere::R, 0, 1e-6).is_some());
     for (surface, incident) in
         [("smith = \"symmetric\"", ""), ("normals = \"hammon-rejection\"", ""), ("", "side = \"inside\"")]
     {
-        let lobe = single_scattering_bins(&case(surface, incident), &grid, Hemisphere::R, 1e-6);
+        let lobe = single_scattering_bins(&case(surface, incident), &grid, Hemisphere::R, 0, 1e-6);
         assert!(lobe.is_none(), "offered for {surface}{incident}");
     }
 }
 
+/// The specular facets of the order-1 albedos below: conductors with Schlick's Fresnel of F0
+/// (`Schlick(1.0)` is F = 1 exactly) or the exact Fresnel of the index `eta + i k`, and
+/// dielectrics of relative index `eta`.
+#[derive(Clone, Copy, Debug)]
+enum Facet {
+    Schlick(f64),
+    Conductor { eta: f64, k: f64 },
+    Dielectric(f64),
+}
+
 /// What a facet of normal `m` sends into `hemisphere` at order 1, before the division by
-/// `G1(wi)`: its Fresnel weight `w(m)` (1 for the conductor with F = 1) times `G2(wi, wo)`,
-/// where `wo` is the mirror or refracted direction (§5).
-fn order_one_weight<N: Ndf>(ndf: &N, wi: DVec3, m: DVec3, eta: Option<f64>, hemisphere: Hemisphere) -> f64 {
+/// `G1(wi)`: its Fresnel weight `w(m)` (`F` in reflection, `1 - F` in transmission) times
+/// `G2(wi, wo)`, where `wo` is the mirror or refracted direction (§5).
+fn order_one_weight<N: Ndf>(ndf: &N, wi: DVec3, m: DVec3, facet: Facet, hemisphere: Hemisphere) -> f64 {
     let c = wi.dot(m);
-    let f = eta.map_or(1.0, |eta| fresnel::dielectric(eta, c));
-    match (hemisphere, eta) {
+    let f = match facet {
+        Facet::Schlick(f0) => fresnel::schlick(f0, c),
+        Facet::Conductor { eta, k } => fresnel::conductor(eta, k, c),
+        Facet::Dielectric(eta) => fresnel::dielectric(eta, c),
+    };
+    match (hemisphere, facet) {
         (Hemisphere::R, _) => {
             let wo = 2.0 * c * m - wi;
             if wo.z > 0.0 { f * single::g2_reflection(ndf, wi, wo) } else { 0.0 }
         }
-        (Hemisphere::T, Some(eta)) => {
+        (Hemisphere::T, Facet::Dielectric(eta)) => {
             let ct2 = 1.0 - (1.0 - c * c) / (eta * eta);
             if ct2 <= 0.0 {
                 return 0.0;
@@ -284,7 +294,7 @@ fn order_one_weight<N: Ndf>(ndf: &N, wi: DVec3, m: DVec3, eta: Option<f64>, hemi
             let wo = (c / eta - ct2.sqrt()) * m - wi / eta;
             if wo.z < 0.0 { (1.0 - f) * single::g2_transmission(ndf, wi, wo) } else { 0.0 }
         }
-        (Hemisphere::T, None) => 0.0,
+        (Hemisphere::T, _) => 0.0,
     }
 }
 
@@ -293,7 +303,7 @@ fn order_one_weight<N: Ndf>(ndf: &N, wi: DVec3, m: DVec3, eta: Option<f64>, hemi
 /// the spherical-cap map of §3.2 (`u` uniform on [0, 1], `phi` on [0, 2 pi), density 1 / 2 pi),
 /// and `1 / G1(wi)` leaves the integral. A lobe as narrow as alpha in `wo` is then a smooth
 /// integrand of `(u, phi)`.
-fn ggx_order_one_albedo_over_the_normals(alpha: f64, wi: DVec3, eta: Option<f64>, hemisphere: Hemisphere) -> f64 {
+fn ggx_order_one_albedo_over_the_normals(alpha: f64, wi: DVec3, facet: Facet, hemisphere: Hemisphere) -> f64 {
     let roughness = Roughness::isotropic(alpha);
     let ndf = Ggx(roughness);
     let ws = roughness.stretch(wi);
@@ -303,7 +313,7 @@ fn ggx_order_one_albedo_over_the_normals(alpha: f64, wi: DVec3, eta: Option<f64>
         let h = DVec3::new(s * phi.cos(), s * phi.sin(), z) + ws;
         roughness.unstretch_normal(DVec3::new(h.x, h.y, h.z.max(0.0)))
     };
-    let weight = |u, phi| order_one_weight(&ndf, wi, normal(u, phi), eta, hemisphere);
+    let weight = |u, phi| order_one_weight(&ndf, wi, normal(u, phi), facet, hemisphere);
     (1.0 + ndf.lambda(wi)) * integrate_2d(weight, (0.0, 1.0), (0.0, TAU), 1e-9).0 / TAU
 }
 
@@ -317,7 +327,7 @@ fn ggx_order_one_albedo_over_the_normals(alpha: f64, wi: DVec3, eta: Option<f64>
 /// horizon.
 /// Independent of the bin quadrature, its grading and the reflection and refraction Jacobians;
 /// it shares Lambda, G2 and Fresnel with the model.
-fn beckmann_order_one_albedo_over_the_slopes(alpha: f64, wi: DVec3, eta: Option<f64>, hemisphere: Hemisphere) -> f64 {
+fn beckmann_order_one_albedo_over_the_slopes(alpha: f64, wi: DVec3, facet: Facet, hemisphere: Hemisphere) -> f64 {
     let ndf = Beckmann(Roughness::isotropic(alpha));
     let integrand = |t: f64, phi: f64| {
         let r = alpha * (-(-t).ln_1p()).sqrt();
@@ -328,7 +338,7 @@ fn beckmann_order_one_albedo_over_the_slopes(alpha: f64, wi: DVec3, eta: Option<
         }
         let m = DVec3::new(-r * phi.cos(), -r * phi.sin(), 1.0).normalize();
         let projected = wi.dot(m).max(0.0) / (wi.z * m.z);
-        if projected == 0.0 { 0.0 } else { projected * order_one_weight(&ndf, wi, m, eta, hemisphere) }
+        if projected == 0.0 { 0.0 } else { projected * order_one_weight(&ndf, wi, m, facet, hemisphere) }
     };
     integrate_2d(integrand, (0.0, 1.0), (0.0, TAU), 1e-9).0 / TAU
 }
@@ -360,11 +370,12 @@ fn narrow_specular_lobes_are_integrated_where_they_peak() {
             let wi = case.incident_direction();
             let hemispheres: &[Hemisphere] =
                 if eta.is_some() { &[Hemisphere::R, Hemisphere::T] } else { &[Hemisphere::R] };
+            let facet = eta.map_or(Facet::Schlick(1.0), Facet::Dielectric);
             for &h in hemispheres {
-                let bins: f64 = single_scattering_bins(&case, &grid, h, 1e-9).unwrap().iter().sum();
+                let bins: f64 = single_scattering_bins(&case, &grid, h, 0, 1e-9).unwrap().iter().sum();
                 let reference = match ndf {
-                    "ggx" => ggx_order_one_albedo_over_the_normals(alpha, wi, eta, h),
-                    _ => beckmann_order_one_albedo_over_the_slopes(alpha, wi, eta, h),
+                    "ggx" => ggx_order_one_albedo_over_the_normals(alpha, wi, facet, h),
+                    _ => beckmann_order_one_albedo_over_the_slopes(alpha, wi, facet, h),
                 };
                 println!("{ndf} alpha {alpha} {material} {theta} {h:?}: bins {bins:.9}, reference {reference:.9}");
                 assert!(
@@ -394,10 +405,10 @@ fn exit_lobes_stopped_at_their_bound_are_within_half_a_standard_error() {
         let case = case_of(&format!(
             "paths = 10\n[surface]\nndf = \"{ndf}\"\nalpha = {alpha}\n[material]\nkind = \"{material}\"\n[incident]\ntheta_deg = 80\nphi_deg = 20\n"
         ));
-        let coarse = single_scattering_bins(&case, &grid, Hemisphere::R, 1e-4).unwrap();
+        let coarse = single_scattering_bins(&case, &grid, Hemisphere::R, 0, 1e-4).unwrap();
         let stderr: Vec<f64> = coarse.iter().map(|e| (e.max(0.0) / photons).sqrt().max(1.0 / photons)).collect();
         let tolerance = |bin: usize| 0.05 * stderr[bin];
-        let lobe = single_scattering_lobe(&case, &grid, Hemisphere::R, &tolerance).unwrap();
+        let lobe = single_scattering_lobe(&case, &grid, Hemisphere::R, 0, &tolerance).unwrap();
         let worst = lobe.error.iter().zip(&stderr).map(|(e, s)| e / s).fold(0.0, f64::max);
         let above = lobe.error.iter().enumerate().filter(|&(bin, e)| *e > tolerance(bin)).count();
         println!(
@@ -415,4 +426,69 @@ fn exit_lobes_stopped_at_their_bound_are_within_half_a_standard_error() {
         stopped += lobe.capped;
     }
     assert!(stopped > 0, "no bin reached the bound");
+}
+
+#[test]
+fn every_channel_of_an_rgb_run_matches_its_own_single_scattering() {
+    // RGB runs whose channels differ strongly, on GGX: a Schlick conductor (F0 0.2, 0.6, 1),
+    // gold (the exact Fresnel of eta + i k per channel), Lambertian facets of albedo 0.9, 0.5,
+    // 0.1; 10^6 photons, 8 x 16 bins. In every channel, the order-1 histogram against the model
+    // of that channel (chi-square, cells with expected count < 5 pooled, at least 16 left; the
+    // albedo against the bins' sum by a z test), and for the conductors the order-1 albedo
+    // against the integral over the visible normals with that channel's Fresnel, by a z test:
+    // Sidak family level 0.01 over the 24 tests. Channel r's model (its parameters used for g
+    // and b) is rejected on g and b, p < 1e-6.
+    let cases = [
+        ("ndf = \"ggx\"\nalpha = 0.5", "kind = \"conductor\"\nfresnel = \"schlick\"\nf0 = [0.2, 0.6, 1.0]", 50.0),
+        (
+            "ndf = \"ggx\"\nalpha = 0.3",
+            "kind = \"conductor\"\nfresnel = \"exact\"\neta = [0.143, 0.424, 1.367]\nk = [3.983, 2.469, 1.864]",
+            70.0,
+        ),
+        ("ndf = \"ggx\"\nalpha = 0.8", "kind = \"diffuse\"\nalbedo = [0.9, 0.5, 0.1]", 30.0),
+    ];
+    // 9 histograms, 9 albedos against their bins, 6 against the integrals.
+    let level = sidak(0.01, 24);
+    for (i, (surface, material, theta)) in cases.into_iter().enumerate() {
+        let toml = format!(
+            "paths = 1_000_000\nseed = {}\n[surface]\n{surface}\n[material]\n{material}\n[incident]\ntheta_deg = {theta}\nphi_deg = 25\n[detector]\ncos_theta_bins = 8\nphi_bins = 16\nmax_order = 2\n",
+            300 + i
+        );
+        let sim = simulate(&toml, 2);
+        let (case, d) = (&sim.cases[0], rgb(&sim, 0));
+        let model = |channel| single_scattering_bins(case, &d.grid, Hemisphere::R, channel, 1e-9).unwrap();
+        let red = model(0);
+        for (channel, name) in ["r", "g", "b"].into_iter().enumerate() {
+            let label = format!("{material} {surface} at {theta} deg, channel {name}").replace('\n', " ");
+            let measured = channel_bins(d, 1, Hemisphere::R, channel);
+            let expected = model(channel);
+            let test = chi_square(&measured, &expected, d.tallies.photons, 5.0);
+            println!("{label}: chi2 {:.1}, dof {}, p {:.3e}", test.statistic, test.dof, test.p_value);
+            let e1 = channel_albedo(d, 1, Hemisphere::R, channel);
+            assert_cells_and_albedo(e1, &test, &expected, level, &label);
+            assert!(test.p_value > level, "{label}: order 1 rejected\n{}", test.worst_cells(10));
+            let facet = match case.material {
+                MaterialConfig::Conductor { f0: Some(f0), .. } => Some(Facet::Schlick(f0.channel(channel))),
+                MaterialConfig::Conductor { eta: Some(eta), k: Some(k), .. } => {
+                    Some(Facet::Conductor { eta: eta.channel(channel), k: k.channel(channel) })
+                }
+                _ => None,
+            };
+            if let Some(facet) = facet {
+                let wi = case.incident_direction();
+                let reference = ggx_order_one_albedo_over_the_normals(case.alpha_x, wi, facet, Hemisphere::R);
+                println!("{label}: E1 {:.5} +- {:.5}, over the normals {reference:.5}", e1.0, e1.1);
+                assert!(
+                    (e1.0 - reference).abs() < two_sided_z(level) * e1.1,
+                    "{label}: E1 = {} +- {}, over the normals {reference}",
+                    e1.0,
+                    e1.1
+                );
+            }
+            if channel > 0 {
+                let wrong = chi_square(&measured, &red, d.tallies.photons, 5.0);
+                assert!(wrong.p_value < 1e-6, "{label}: channel r's model not rejected, p = {}", wrong.p_value);
+            }
+        }
+    }
 }

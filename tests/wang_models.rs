@@ -86,7 +86,7 @@ fn correlated_order_one_is_exact_single_scattering() {
         let sim = simulate_with(&toml, CORRELATED);
         let d = mono(&sim, 0);
         for &h in hemispheres {
-            let expected = single_scattering_bins(&sim.cases[0], &d.grid, h, 1e-10).unwrap();
+            let expected = single_scattering_bins(&sim.cases[0], &d.grid, h, 0, 1e-10).unwrap();
             let test = chi_square(&weighted_bins(d, 1, h), &expected, d.tallies.photons, 5.0);
             assert!(test.p_value > level, "{material} {h:?}: correlated order 1 rejected\n{}", test.worst_cells(10));
         }

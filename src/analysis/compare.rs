@@ -199,10 +199,11 @@ fn is_tested(config: &Config, order: usize) -> bool {
 }
 
 /// The closed-form models' lobes: `single` (order 1) and `hammon-fit` (order 1, folded into
-/// all orders for a "1+" slot, and all orders), each bin integrated to a tolerance tied to the
-/// measured bin's standard error (channel 0 of RGB runs).
+/// all orders for a "1+" slot, and all orders), in every channel of the run with that
+/// channel's material parameters, each bin integrated to a tolerance tied to the measured bin's
+/// standard error ([`tolerances`]). The equal channels of a material with one value per
+/// parameter in an RGB run are integrated once.
 fn closed_form(model: Model, run: &RunDir, measured: &Lobes, progress: &ProgressBar) -> Predictions {
-    let photons = run.config.paths as f64;
     let folded = folded_slot(&run.config);
     if model == Model::Single && folded == Some(1) {
         return Predictions {
@@ -214,55 +215,75 @@ fn closed_form(model: Model, run: &RunDir, measured: &Lobes, progress: &Progress
             ..Predictions::default()
         };
     }
-    // (case, slot, hemisphere) of every lobe the model predicts.
-    let mut wanted: Vec<(&Case, usize, Hemisphere)> = Vec::new();
+    let channels = if run.config.is_rgb() { 3 } else { 1 };
+    // (case, slot, hemisphere, channels) of every lobe the model integrates: the channels of
+    // an RGB material one by one, those of a material with one value per parameter together.
+    let mut wanted: Vec<(&Case, usize, Hemisphere, Vec<usize>)> = Vec::new();
     for case in &run.cases {
-        match model {
-            Model::Single => wanted.extend(hemispheres(case).iter().map(|&h| (case, 1, h))),
-            _ => wanted.extend([(case, 0, Hemisphere::R), (case, 1, Hemisphere::R)]),
+        let lobes: Vec<(usize, Hemisphere)> = match model {
+            Model::Single => hemispheres(case).iter().map(|&h| (1, h)).collect(),
+            _ => vec![(0, Hemisphere::R), (1, Hemisphere::R)],
+        };
+        let shared: Vec<Vec<usize>> = if case.material.is_rgb() {
+            (0..channels).map(|c| vec![c]).collect()
+        } else {
+            vec![(0..channels).collect()]
+        };
+        for (slot, h) in lobes {
+            wanted.extend(shared.iter().map(|cs| (case, slot, h, cs.clone())));
         }
     }
     progress.set_length(wanted.len() as u64);
-    let empty: Vec<BinValue> = vec![BinValue::default(); run.grid.bins()];
-    let results: Vec<Option<(ModelLobe, LobeIntegrals, Vec<f64>)>> = wanted
-        .into_iter()
-        .map(|(case, slot, h)| {
-            let bins = measured.get(case.index, slot, &hemisphere_name(h), 0).unwrap_or(&empty);
-            let tolerances: Vec<f64> =
-                bins.iter().map(|b| QUADRATURE_FRACTION * b.energy_stderr.max(1.0 / photons)).collect();
-            let tolerance = |bin: usize| tolerances[bin];
-            let integrals = match model {
-                Model::Single => single_scattering_lobe(case, &run.grid, h, &tolerance),
-                _ => {
-                    let part = if slot == 1 && folded != Some(1) { HammonFitPart::Single } else { HammonFitPart::All };
-                    hammon_fit_lobe_bins(case, &run.grid, part, &tolerance)
-                }
-            };
-            progress.inc(1);
-            integrals.map(|integrals| {
-                let lobe = ModelLobe {
-                    case: case.index,
-                    order: slot,
-                    hemisphere: h,
-                    channel: 0,
-                    energy: integrals.energy.clone(),
-                    stderr: vec![0.0; run.grid.bins()],
-                };
-                (lobe, integrals, tolerances)
-            })
-        })
-        .collect();
     let mut out = Predictions::default();
-    for (lobe, integrals, tolerances) in results.into_iter().flatten() {
+    for (case, slot, h, shared) in wanted {
+        let tolerances = tolerances(run, measured, (case.index, slot, h), &shared);
+        let tolerance = |bin: usize| tolerances[bin];
+        let integrals = match model {
+            Model::Single => single_scattering_lobe(case, &run.grid, h, shared[0], &tolerance),
+            _ => {
+                let part = if slot == 1 && folded != Some(1) { HammonFitPart::Single } else { HammonFitPart::All };
+                hammon_fit_lobe_bins(case, &run.grid, part, shared[0], &tolerance)
+            }
+        };
+        progress.inc(1);
+        let Some(integrals) = integrals else { continue };
         out.capped += integrals.capped;
         if integrals.capped > 0 {
             for (error, tol) in integrals.error.iter().zip(&tolerances) {
                 out.worst_capped = out.worst_capped.max(error / tol);
             }
         }
-        out.lobes.push(lobe);
+        out.lobes.extend(shared.into_iter().map(|channel| ModelLobe {
+            case: case.index,
+            order: slot,
+            hemisphere: h,
+            channel,
+            energy: integrals.energy.clone(),
+            stderr: vec![0.0; run.grid.bins()],
+        }));
     }
     out
+}
+
+/// The quadrature tolerance of every bin of a closed-form model's lobe (case, slot,
+/// hemisphere) that stands for the run's `channels`: [`QUADRATURE_FRACTION`] of the smallest
+/// standard error of the measured bin over those channels, at least of one photon's energy.
+fn tolerances(
+    run: &RunDir,
+    measured: &Lobes,
+    (case, slot, h): (usize, usize, Hemisphere),
+    channels: &[usize],
+) -> Vec<f64> {
+    let photons = run.config.paths as f64;
+    let empty: Vec<BinValue> = vec![BinValue::default(); run.grid.bins()];
+    let lobes: Vec<&[BinValue]> =
+        channels.iter().map(|&c| measured.get(case, slot, &hemisphere_name(h), c).map_or(&empty[..], |b| b)).collect();
+    (0..run.grid.bins())
+        .map(|bin| {
+            let se = lobes.iter().map(|l| l[bin].energy_stderr).fold(f64::INFINITY, f64::min);
+            QUADRATURE_FRACTION * se.max(1.0 / photons)
+        })
+        .collect()
 }
 
 /// The Monte Carlo models' lobes: the model's estimator walked with the run's config (the same
@@ -374,21 +395,12 @@ fn compensation(
     progress: &ProgressBar,
 ) -> Predictions {
     let Some(compensation) = Compensation::of(model) else { return Predictions::default() };
-    let photons = run.config.paths as f64;
     let channels = if run.config.is_rgb() { 3 } else { 1 };
-    let empty: Vec<BinValue> = vec![BinValue::default(); run.grid.bins()];
     let mut cache = table.cloned().map_or_else(AlbedoCache::default, AlbedoCache::with_table);
     let mut out = Predictions::default();
     progress.set_length(run.cases.len() as u64);
     for case in &run.cases {
-        let tolerances: Vec<f64> = (0..run.grid.bins())
-            .map(|bin| {
-                let se = (0..channels)
-                    .map(|c| measured.get(case.index, 0, "R", c).unwrap_or(&empty)[bin].energy_stderr)
-                    .fold(f64::INFINITY, f64::min);
-                QUADRATURE_FRACTION * se.max(1.0 / photons)
-            })
-            .collect();
+        let tolerances = tolerances(run, measured, (case.index, 0, Hemisphere::R), &Vec::from_iter(0..channels));
         let tolerance = |bin: usize| tolerances[bin];
         let lobes: Vec<LobeIntegrals> = if channels == 3 {
             compensated_bins::<3>(compensation, case, &run.grid, &tolerance, &mut cache).map(Vec::from)

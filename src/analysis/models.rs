@@ -26,20 +26,21 @@ fn direction(u: f64, phi: f64, phi_i: f64, sign: f64) -> DVec3 {
     DVec3::new(s * cp, s * sp, sign * u)
 }
 
-/// A cosine-weighted lobe `wo -> f(wi, wo) |cos theta_o|` for a fixed `wi`, channel 0.
+/// A cosine-weighted lobe `wo -> f(wi, wo) |cos theta_o|` for a fixed `wi` and colour channel.
 type Lobe<'a> = Box<dyn Fn(DVec3) -> f64 + Sync + 'a>;
 
-/// The specular part of the order-1 lobe of a facet material (§5): facets that reflect (and
-/// refract) like mirrors; `None` for diffuse facets.
-fn specular_part<'a, N: Ndf>(ndf: &'a N, material: &MaterialConfig, wi: DVec3) -> Option<Lobe<'a>> {
+/// The specular part of the order-1 lobe of a facet material in colour channel `channel`
+/// (§5, with that channel's Fresnel): facets that reflect (and refract) like mirrors; `None`
+/// for diffuse facets.
+fn specular_part<'a, N: Ndf>(ndf: &'a N, material: &MaterialConfig, channel: usize, wi: DVec3) -> Option<Lobe<'a>> {
     match *material {
         MaterialConfig::Conductor { fresnel: kind, f0, eta, k, .. } => {
             let f = move |c: f64| match kind {
                 FresnelKind::None => 1.0,
-                FresnelKind::Schlick => fresnel::schlick(f0.expect("validated").to_array::<1>()[0], c),
+                FresnelKind::Schlick => fresnel::schlick(f0.expect("validated").channel(channel), c),
                 FresnelKind::Exact => fresnel::conductor(
-                    eta.expect("validated").to_array::<1>()[0],
-                    k.expect("validated").to_array::<1>()[0],
+                    eta.expect("validated").channel(channel),
+                    k.expect("validated").channel(channel),
                     c,
                 ),
             };
@@ -53,29 +54,31 @@ fn specular_part<'a, N: Ndf>(ndf: &'a N, material: &MaterialConfig, wi: DVec3) -
             }
         })),
         MaterialConfig::Hammon { f0, .. } => {
-            let f0 = f0.to_array::<1>()[0];
+            let f0 = f0.channel(channel);
             Some(Box::new(move |wo| single::reflection(ndf, wi, wo, |c| fresnel::schlick(f0, c))))
         }
         MaterialConfig::Diffuse { .. } => None,
     }
 }
 
-/// The diffuse part of the order-1 lobe of a facet material: facets that scatter about their
-/// normal (Lambertian facets, Hammon's Fresnel-weighted exit), their visible normals integrated
-/// by the rule `visible()` builds; `None` for purely specular facets.
+/// The diffuse part of the order-1 lobe of a facet material in colour channel `channel` (with
+/// that channel's albedo and Fresnel): facets that scatter about their normal (Lambertian
+/// facets, Hammon's Fresnel-weighted exit), their visible normals integrated by the rule
+/// `visible()` builds; `None` for purely specular facets.
 fn diffuse_part<'a, N: Ndf>(
     ndf: &'a N,
     material: &MaterialConfig,
+    channel: usize,
     wi: DVec3,
     visible: impl FnOnce() -> Vec<(DVec3, f64)>,
 ) -> Option<Lobe<'a>> {
     match *material {
         MaterialConfig::Diffuse { albedo, .. } => {
-            let (rho, visible) = (albedo.to_array::<1>()[0], visible());
+            let (rho, visible) = (albedo.channel(channel), visible());
             Some(Box::new(move |wo| exit_lobe(ndf, wi, wo, &visible, |_, c| rho * c / PI)))
         }
         MaterialConfig::Hammon { f0, albedo, .. } => {
-            let (f0, rho, visible) = (f0.to_array::<1>()[0], albedo.to_array::<1>()[0], visible());
+            let (f0, rho, visible) = (f0.channel(channel), albedo.channel(channel), visible());
             let k = 21.0 / (20.0 * PI);
             Some(Box::new(move |wo| {
                 exit_lobe(ndf, wi, wo, &visible, |ci, c| {
@@ -187,11 +190,19 @@ impl LobeIntegrals {
     }
 }
 
-/// Expected order-1 energy per photon in every bin of `hemisphere` (index `cos * phi_bins +
-/// phi`), to the absolute tolerance `abs_tol` per bin, or `None` where single scattering is
-/// not available: Hammon's Smith or normals, or light from inside.
-pub fn single_scattering_bins(case: &Case, grid: &Grid, hemisphere: Hemisphere, abs_tol: f64) -> Option<Vec<f64>> {
-    single_scattering_lobe(case, grid, hemisphere, &|_| abs_tol).map(|lobe| lobe.energy)
+/// Expected order-1 energy per photon (§5) in every bin of `hemisphere` (index
+/// `cos * phi_bins + phi`) in colour channel `channel` (0 = r, 1 = g, 2 = b, with that
+/// channel's material parameters; 0 for mono runs), to the absolute tolerance `abs_tol` per
+/// bin, or `None` where single scattering is not available: Hammon's Smith or normals, or light
+/// from inside.
+pub fn single_scattering_bins(
+    case: &Case,
+    grid: &Grid,
+    hemisphere: Hemisphere,
+    channel: usize,
+    abs_tol: f64,
+) -> Option<Vec<f64>> {
+    single_scattering_lobe(case, grid, hemisphere, channel, &|_| abs_tol).map(|lobe| lobe.energy)
 }
 
 /// [`single_scattering_bins`] with a tolerance per bin, `tolerance(bin)`, and the quadrature's
@@ -200,6 +211,7 @@ pub fn single_scattering_lobe(
     case: &Case,
     grid: &Grid,
     hemisphere: Hemisphere,
+    channel: usize,
     tolerance: &(dyn Fn(usize) -> f64 + Sync),
 ) -> Option<LobeIntegrals> {
     if case.smith != SmithKind::Exact || case.normals != NormalsKind::Vndf || case.side != IncidentSide::Outside {
@@ -207,19 +219,20 @@ pub fn single_scattering_lobe(
     }
     let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
     Some(match case.ndf {
-        NdfKind::Ggx => bins_for(&Ggx(roughness), case, grid, hemisphere, tolerance),
-        NdfKind::Beckmann => bins_for(&Beckmann(roughness), case, grid, hemisphere, tolerance),
+        NdfKind::Ggx => bins_for(&Ggx(roughness), case, grid, (hemisphere, channel), tolerance),
+        NdfKind::Beckmann => bins_for(&Beckmann(roughness), case, grid, (hemisphere, channel), tolerance),
     })
 }
 
-/// The order-1 lobe of `case` in every bin: the sum of its parts, the specular one graded
-/// towards its peak within [`MAX_BIN_EVALUATIONS`], the diffuse one (smooth) within
-/// [`MAX_EXIT_BIN_EVALUATIONS`], each to an equal share of a bin's tolerance.
+/// The order-1 lobe of `case` in every bin of `hemisphere`, colour channel `channel`: the sum
+/// of its parts, the specular one graded towards its peak within [`MAX_BIN_EVALUATIONS`], the
+/// diffuse one (smooth) within [`MAX_EXIT_BIN_EVALUATIONS`], each to an equal share of a bin's
+/// tolerance.
 fn bins_for<N: Ndf>(
     ndf: &N,
     case: &Case,
     grid: &Grid,
-    hemisphere: Hemisphere,
+    (hemisphere, channel): (Hemisphere, usize),
     tolerance: &(dyn Fn(usize) -> f64 + Sync),
 ) -> LobeIntegrals {
     let mut lobe = LobeIntegrals { energy: vec![0.0; grid.bins()], error: vec![0.0; grid.bins()], capped: 0 };
@@ -233,8 +246,9 @@ fn bins_for<N: Ndf>(
         NdfKind::Beckmann => beckmann_visible_rule(&Beckmann(roughness), wi),
     };
     let parts: Vec<_> = [
-        specular_part(ndf, &case.material, wi).map(|part| (part, specular_peak(case, hemisphere), MAX_BIN_EVALUATIONS)),
-        diffuse_part(ndf, &case.material, wi, visible).map(|part| (part, None, MAX_EXIT_BIN_EVALUATIONS)),
+        specular_part(ndf, &case.material, channel, wi)
+            .map(|part| (part, specular_peak(case, hemisphere), MAX_BIN_EVALUATIONS)),
+        diffuse_part(ndf, &case.material, channel, wi, visible).map(|part| (part, None, MAX_EXIT_BIN_EVALUATIONS)),
     ]
     .into_iter()
     .flatten()
@@ -349,11 +363,18 @@ pub fn hammon_fit_lobe(alpha: f64, f0: f64, albedo: f64, wi: DVec3, wo: DVec3, p
     (specular + albedo * (single + albedo * multi)) * nv
 }
 
-/// Expected energy per photon of Hammon's fit in every reflection bin of a `hammon` case
-/// (isotropic GGX, light from outside; channel 0) to `abs_tol` per bin, or `None` where it does
-/// not apply.
-pub fn hammon_fit_bins(case: &Case, grid: &Grid, part: HammonFitPart, abs_tol: f64) -> Option<Vec<f64>> {
-    hammon_fit_lobe_bins(case, grid, part, &|_| abs_tol).map(|lobe| lobe.energy)
+/// Expected energy per photon of Hammon's fit ([`hammon_fit_lobe`]) in every reflection bin of
+/// a `hammon` case (isotropic GGX, light from outside) in colour channel `channel` (0 = r, 1 =
+/// g, 2 = b, with that channel's F0 and albedo; 0 for mono runs) to `abs_tol` per bin, or
+/// `None` where it does not apply.
+pub fn hammon_fit_bins(
+    case: &Case,
+    grid: &Grid,
+    part: HammonFitPart,
+    channel: usize,
+    abs_tol: f64,
+) -> Option<Vec<f64>> {
+    hammon_fit_lobe_bins(case, grid, part, channel, &|_| abs_tol).map(|lobe| lobe.energy)
 }
 
 /// [`hammon_fit_bins`] with a tolerance per bin and the quadrature's error estimates and bound.
@@ -361,13 +382,14 @@ pub fn hammon_fit_lobe_bins(
     case: &Case,
     grid: &Grid,
     part: HammonFitPart,
+    channel: usize,
     tolerance: &(dyn Fn(usize) -> f64 + Sync),
 ) -> Option<LobeIntegrals> {
     let MaterialConfig::Hammon { f0, albedo, .. } = &case.material else { return None };
     if case.ndf != NdfKind::Ggx || case.alpha_x != case.alpha_y || case.side != IncidentSide::Outside {
         return None;
     }
-    let (f0, albedo) = (f0.to_array::<1>()[0], albedo.to_array::<1>()[0]);
+    let (f0, albedo) = (f0.channel(channel), albedo.channel(channel));
     let wi = case.incident_direction();
     let peak = specular_peak(case, Hemisphere::R);
     Some(integrate_bins(case, grid, Hemisphere::R, (peak, tolerance, MAX_BIN_EVALUATIONS), |wo| {
@@ -450,9 +472,9 @@ mod tests {
                                 )
                             };
                             let (u, phi) = match case.ndf {
-                                NdfKind::Ggx => widths(specular_part(&Ggx(roughness), &case.material, wi).unwrap()),
+                                NdfKind::Ggx => widths(specular_part(&Ggx(roughness), &case.material, 0, wi).unwrap()),
                                 NdfKind::Beckmann => {
-                                    widths(specular_part(&Beckmann(roughness), &case.material, wi).unwrap())
+                                    widths(specular_part(&Beckmann(roughness), &case.material, 0, wi).unwrap())
                                 }
                             };
                             for (axis, ratio) in [("cos", peak.scale.0 / u), ("phi", peak.scale.1 / phi)] {

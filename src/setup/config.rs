@@ -161,6 +161,11 @@ impl Channels {
         }
     }
 
+    /// The value of channel `channel` (0 = r, 1 = g, 2 = b; a mono value is every channel's).
+    pub fn channel(self, channel: usize) -> f64 {
+        self.to_array::<3>()[channel]
+    }
+
     fn values(self) -> Vec<f64> {
         match self {
             Channels::Mono(v) => vec![v],

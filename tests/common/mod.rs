@@ -84,15 +84,34 @@ pub fn mono(sim: &Simulation, i: usize) -> &Detector<1> {
     }
 }
 
+/// The three-channel detector of case `i` (an RGB run).
+pub fn rgb(sim: &Simulation, i: usize) -> &Detector<3> {
+    match &sim.results[i] {
+        CaseResult::Rgb(d) => d,
+        CaseResult::Mono(_) => panic!("expected an RGB case"),
+    }
+}
+
 /// The per-photon moments of every bin of one order slot and hemisphere.
 pub fn weighted_bins(d: &Detector<1>, slot: usize, hemisphere: Hemisphere) -> Vec<WeightedBin> {
+    channel_bins(d, slot, hemisphere, 0)
+}
+
+/// The per-photon moments of every bin of one order slot and hemisphere in colour channel
+/// `channel`.
+pub fn channel_bins<const C: usize>(
+    d: &Detector<C>,
+    slot: usize,
+    hemisphere: Hemisphere,
+    channel: usize,
+) -> Vec<WeightedBin> {
     let n = d.tallies.photons as f64;
     let bins = d.grid.bins();
     let empty = OrderTallies { bins: vec![Default::default(); 2 * bins], albedo: Default::default() };
     let tallies = d.tallies.orders.get(slot).unwrap_or(&empty);
     tallies.bins[hemisphere as usize * bins..(hemisphere as usize + 1) * bins]
         .iter()
-        .map(|t| WeightedBin { mean: t.sum[0].to_f64() / n, second_moment: t.sum_sq[0].to_f64() / n })
+        .map(|t| WeightedBin { mean: t.sum[channel].to_f64() / n, second_moment: t.sum_sq[channel].to_f64() / n })
         .collect()
 }
 
@@ -106,10 +125,20 @@ pub fn bin_counts(d: &Detector<1>, slot: usize, hemisphere: Hemisphere) -> Vec<u
 
 /// Albedo and standard error of one order slot and hemisphere.
 pub fn albedo(d: &Detector<1>, slot: usize, hemisphere: Hemisphere) -> (f64, f64) {
+    channel_albedo(d, slot, hemisphere, 0)
+}
+
+/// Albedo and standard error of one order slot and hemisphere in colour channel `channel`.
+pub fn channel_albedo<const C: usize>(
+    d: &Detector<C>,
+    slot: usize,
+    hemisphere: Hemisphere,
+    channel: usize,
+) -> (f64, f64) {
     d.tallies
         .orders
         .get(slot)
-        .map_or((0.0, 0.0), |t| t.albedo[hemisphere as usize].mean_and_stderr(d.tallies.photons, 0))
+        .map_or((0.0, 0.0), |t| t.albedo[hemisphere as usize].mean_and_stderr(d.tallies.photons, channel))
 }
 
 /// docs/theory.md §9.4: per-order albedos E1..E6 of the random walk, conductor F = 1, isotropic
