@@ -879,8 +879,8 @@ fn report(
         let _ = writeln!(out, "  its {} lobes with the lowest p, worst first:", mine.len().min(5));
         let _ = writeln!(
             out,
-            "  {:>5} {:>5} {:>4} {:>3} {:>10} {:>6} {:>10} {:>8} {:>8} {:>11}  {}",
-            "case", "order", "hemi", "ch", "chi2", "dof", "p", "rel L1", "rel L2", "albedo diff", "verdict"
+            "  {:>5} {:>5} {:>4} {:>3} {:>10} {:>6} {:>10} {:>8} {:>8} {:>11}  verdict",
+            "case", "order", "hemi", "ch", "chi2", "dof", "p", "rel L1", "rel L2", "albedo diff"
         );
         for c in mine.iter().take(5) {
             let order = if folded == Some(c.lobe.1) { format!("{}+", c.lobe.1) } else { c.lobe.1.to_string() };

@@ -203,7 +203,7 @@ fn legend_lines(entries: &[(Key, String)], width: u32) -> Vec<std::ops::Range<us
 }
 
 /// Draws a legend centred in `area` (a band outside the panels), entries left to right, in as
-/// many lines as its width needs, [`LEGEND_LINE`] apart.
+/// many lines as its width needs, `LEGEND_LINE` apart.
 pub fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, entries: &[(Key, String)]) -> Result<()> {
     let font = (FONT, CAPTION).into_font();
     let widths = legend_widths(entries);
