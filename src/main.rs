@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use std::time::Duration;
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use smithwalk::atomic::{lock_dir, prepare_dir};
 use smithwalk::engine::checkpoint::{self, Checkpointer};
@@ -240,16 +240,34 @@ fn bench(paths: u64, repeats: usize) -> Result<()> {
 /// a 1% relative standard error and, in brackets, the reference's time over it (`-`: no light
 /// goes there; `exact`: no variance, as the all-orders reflection of a conductor with F = 1).
 fn bench_precision(paths: u64, energy: &EnergyConfig) -> Result<()> {
-    use smithwalk::engine::bench::{precision_cases, precision_config, time_to_precision};
+    use smithwalk::engine::bench::{MIN_PRECISION_PATHS, precision_cases, precision_config, time_to_precision};
+    if paths < MIN_PRECISION_PATHS {
+        bail!(
+            "`--paths` = {paths} is not allowed with `--precision`: at least {MIN_PRECISION_PATHS} photons per \
+             case (fewer cannot resolve the third orders: an order no photon reached would read `-`, \
+             one without observed variance `exact`)"
+        );
+    }
     // The cases' configurations with this policy and photon count are checked before the table
     // starts.
     let cases = precision_cases();
     for case in &cases {
-        precision_config(case, energy, paths)?;
+        precision_config(case, energy, paths).with_context(|| {
+            format!(
+                "the options `--paths {paths} --split {} --threshold {}` (every case's `paths` and `[energy]`)",
+                energy.split, energy.threshold
+            )
+        })?;
     }
     let mut out = std::io::stdout().lock();
-    let policy = format!("[energy] split = {}, threshold = {}", energy.split, energy.threshold);
-    if !print_line(&mut out, &policy)? {
+    let legend = format!(
+        "[energy] split = {}, threshold = {}. Per albedo (orders 1, 2, 3 and all; R, T): CPU seconds on \
+         1 thread to a 1% relative standard error, and in brackets the Heitz 2016 reference's time \
+         over it (its rate measured per case, docs/performance.md); `exact`: no variance on either \
+         side; `-`: no light.",
+        energy.split, energy.threshold
+    );
+    if !print_line(&mut out, &legend)? {
         return Ok(());
     }
     let quantities = ["R1", "R2", "R3", "R", "T1", "T2", "T3", "T"];

@@ -100,6 +100,11 @@ pub fn measure_pair(case: usize, paths: u64) -> Result<f64> {
     Ok(2.0 * a?.paths_per_second.min(b?.paths_per_second))
 }
 
+/// The fewest photons per case of a time-to-precision table: the third orders of the smooth
+/// cases carry about 10^-3 of the light, so fewer photons leave them with too few escapes for
+/// a variance.
+pub const MIN_PRECISION_PATHS: u64 = 100_000;
+
 /// A case of the time-to-precision table: a GGX facet material at `(alpha, theta_i in radians)`
 /// and the rate of the Heitz et al. 2016 reference code on it.
 #[derive(Clone, Copy, Debug)]
@@ -146,13 +151,19 @@ pub fn precision_cases() -> Vec<PrecisionCase> {
 }
 
 /// The run configuration of a time-to-precision case with `paths` photons under `energy`; an
-/// error that names the field if `energy` or `paths` is not allowed.
+/// error that names the field (`paths`, `energy.threshold`) if `energy` or `paths` is not
+/// allowed.
 pub fn precision_config(case: &PrecisionCase, energy: &EnergyConfig, paths: u64) -> Result<Config> {
     let PrecisionCase { toml, alpha, theta, .. } = case;
-    Ok(Config::parse(&format!(
-        "paths = {paths}\nseed = 1\n[surface]\nalpha = {alpha}\n[material]\n{toml}\n[incident]\ntheta_rad = {theta}\n[detector]\nmax_order = 4\n[energy]\nsplit = {}\nthreshold = {:e}\n",
-        energy.split, energy.threshold
-    ))?)
+    // The case's own text is valid; the options are set and checked as fields, so that a NaN
+    // is refused by name like any other value instead of failing to parse as TOML.
+    let mut config = Config::parse(&format!(
+        "paths = 2\nseed = 1\n[surface]\nalpha = {alpha}\n[material]\n{toml}\n[incident]\ntheta_rad = {theta}\n[detector]\nmax_order = 4\n"
+    ))?;
+    config.paths = paths;
+    config.energy = energy.clone();
+    config.validate()?;
+    Ok(config)
 }
 
 /// One per-order albedo of a time-to-precision measurement.
@@ -253,8 +264,12 @@ mod tests {
 
     #[test]
     fn a_bad_policy_names_its_field() {
-        let bad = EnergyConfig { split: true, threshold: 0.0 };
-        let err = precision_config(&case_of("conductor"), &bad, 100).unwrap_err();
-        assert!(err.to_string().contains("energy.threshold"), "{err}");
+        for threshold in [0.0, 2.0, f64::NAN] {
+            let bad = EnergyConfig { split: true, threshold };
+            let err = precision_config(&case_of("conductor"), &bad, 100).unwrap_err().to_string();
+            assert!(err.contains(&format!("`energy.threshold` = {threshold}")), "{err}");
+        }
+        let err = precision_config(&case_of("conductor"), &EnergyConfig::default(), 0).unwrap_err().to_string();
+        assert!(err.contains("`paths` = 0"), "{err}");
     }
 }
