@@ -103,6 +103,23 @@ fn every_bad_config_names_its_field_value_and_what_is_allowed() {
 }
 
 #[test]
+fn type_errors_say_what_is_allowed_in_user_terms() {
+    let with = |from: &str, to: &str| BASE.replace(from, to);
+    let cases = [
+        (with("paths = 1000", "paths = 1e6"), "`paths` = 1e6 is not allowed (line 1)", "e.g. 1000000 or 1_000_000"),
+        (with("paths = 1000", "paths = -5"), "`paths` = -5 is not allowed", "an integer from 2 to 10^15"),
+        (format!("{BASE}[detector]\nphi_bins = 2.5\n"), "`detector.phi_bins` = 2.5", "an integer from 1 to 4096"),
+        (format!("{BASE}[detector]\nmax_order = \"3\"\n"), "`detector.max_order` = \"3\"", "an integer >= 1"),
+        (with("theta_deg = 30", "theta_deg = \"30\""), "`incident.theta_deg` = \"30\"", "expected a number"),
+    ];
+    for (toml, value, allowed) in cases {
+        let e = error_of(&toml);
+        assert!(e.contains(value) && e.contains(allowed), "{e}");
+        assert!(!["u32", "u64", "usize", "f64"].iter().any(|rust| e.contains(rust)), "{e}");
+    }
+}
+
+#[test]
 fn a_huge_sweep_is_refused_before_it_is_expanded() {
     let thetas: Vec<String> = (0..1000).map(|i| format!("{}", i as f64 * 0.09)).collect();
     let phis: Vec<String> = (0..1001).map(|i| i.to_string()).collect();

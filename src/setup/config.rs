@@ -631,6 +631,17 @@ impl Config {
         Ok(config)
     }
 
+    /// Parses and validates a configuration given as a table (the Python package's dict) with
+    /// the checks of a file; errors name it `<dict>` and no lines, which a dict does not have.
+    pub fn from_table(table: &toml::Table) -> Result<Self, ConfigError> {
+        let in_dict = |e: ConfigError| e.in_source("<dict>");
+        let text = toml::to_string(table)
+            .map_err(|e| in_dict(ConfigError::Parse { path: String::new(), message: e.to_string() }))?;
+        let config: Config = parse_toml_with(&text, false).map_err(in_dict)?;
+        config.validate().map_err(in_dict)?;
+        Ok(config)
+    }
+
     /// Checks every field against what the simulator supports.
     pub fn validate(&self) -> Result<(), ConfigError> {
         if self.paths < 2 {
@@ -770,8 +781,16 @@ impl Config {
 /// Deserializes TOML text; an error is one line naming the field (its dotted path), the value
 /// as written (shortened) and what is allowed, whatever the input's size.
 pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, ConfigError> {
+    parse_toml_with(text, true)
+}
+
+/// [`parse_toml`], with the errors' line numbers only when `lines` (text made from a dict has
+/// lines the user never saw).
+fn parse_toml_with<T: serde::de::DeserializeOwned>(text: &str, lines: bool) -> Result<T, ConfigError> {
     let parse = |message: String| ConfigError::Parse { path: "<text>".into(), message };
-    let line_of = |e: &toml::de::Error| e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+    let shown = |line: Option<usize>| line.filter(|_| lines);
+    let line_of =
+        |e: &toml::de::Error| shown(e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1));
     let at = |e: &toml::de::Error| at_line(line_of(e));
     let deserializer = toml::de::Deserializer::parse(text)
         .map_err(|e| parse(format!("not TOML{}: {}", at(&e), shorten(e.message(), MESSAGE_CHARS))))?;
@@ -779,7 +798,7 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, Confi
         let field = e.path().to_string();
         let inner = e.inner();
         let value = inner.span().and_then(|s| text.get(s)).map_or("?".to_string(), |v| shorten(v, VALUE_CHARS));
-        let allowed = shorten(inner.message(), MESSAGE_CHARS);
+        let allowed = shorten(&in_user_terms(&field, inner.message()), MESSAGE_CHARS);
         // Keys inside a material (a table tagged by `kind`) are not on serde's path.
         let key = |prefix: &str| inner.message().strip_prefix(prefix).and_then(|m| m.split('`').next());
         let line = at(inner);
@@ -797,7 +816,7 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, Confi
             (None, Some(k)) => {
                 // The span of a table of `[[material]]` is that of the first one.
                 let line = match material_index(&field) {
-                    Some(Some(i)) => material_header(&text.lines().collect::<Vec<_>>(), Some(i)).map(|h| h + 1),
+                    Some(Some(i)) => shown(material_header(&text.lines().collect::<Vec<_>>(), Some(i)).map(|h| h + 1)),
                     _ => line_of(inner),
                 };
                 let place = line.map_or(String::new(), |n| format!(" from the table at line {n}"));
@@ -807,13 +826,28 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, Confi
             _ if field == "." => parse(format!("{allowed}{line}")),
             _ => match material_culprit(text, &field, inner.message()) {
                 Some(Culprit { key, value, line }) => {
-                    let line = at_line(line);
+                    let line = at_line(shown(line));
                     parse(format!("`{field}.{key}` = {value} is not allowed{line}: {allowed}"))
                 }
                 None => parse(format!("`{field}` = {value} is not allowed{line}: {allowed}")),
             },
         }
     })
+}
+
+/// serde's `message` about `field` with Rust's type names said in user terms: `expected u64`
+/// is an integer in the field's range, `expected f64` a number.
+fn in_user_terms(field: &str, message: &str) -> String {
+    let integer = match without_indices(field).as_str() {
+        "paths" | "compare.paths" => "an integer from 2 to 10^15, e.g. 1000000 or 1_000_000",
+        "seed" => "an integer >= 0",
+        "detector.cos_theta_bins" | "detector.phi_bins" => "an integer from 1 to 4096",
+        _ => "an integer >= 1",
+    };
+    ["u64", "usize", "u32"]
+        .into_iter()
+        .fold(message.to_string(), |m, rust| m.replace(&format!("expected {rust}"), &format!("expected {integer}")))
+        .replace("expected f64", "expected a number")
 }
 
 /// ` (line n)`, or nothing without a line.

@@ -11,7 +11,7 @@ use anyhow::Context as _;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PyDict};
+use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyTuple};
 use smithwalk::engine::detector::{Detector, Grid};
 use smithwalk::engine::run::{CaseResult, Estimator, Shard};
 use smithwalk::setup::config::{Config, ConfigError, Model};
@@ -36,23 +36,64 @@ fn runtime_error(e: anyhow::Error) -> PyErr {
 }
 
 /// Reads and validates a configuration given as `kind`: `"path"` (a TOML file), `"toml"` (TOML
-/// text) or `"json"` (a Python dict serialized as JSON, which is turned into TOML text so that
-/// it goes through exactly the parser and checks of a file).
-fn load_config(source: &str, kind: &str) -> PyResult<Config> {
+/// text) or `"dict"` (a Python dict, turned into a TOML table so that it goes through exactly
+/// the parser and checks of a file).
+fn load_config(source: &Bound<'_, PyAny>, kind: &str) -> PyResult<Config> {
     let parsed = match kind {
-        "path" => Config::load(Path::new(source)),
-        "toml" => Config::parse(source),
-        "json" => {
-            let value: serde_json::Value =
-                serde_json::from_str(source).map_err(|e| PyValueError::new_err(format!("config dict: {e}")))?;
-            let text = toml::to_string(&value).map_err(|e| {
-                PyValueError::new_err(format!("config dict is not valid: {e} (values must be TOML values, not None)"))
-            })?;
-            Config::parse(&text).map_err(|e| e.in_source("<dict>"))
-        }
+        "path" => Config::load(Path::new(&source.extract::<String>()?)),
+        "toml" => Config::parse(&source.extract::<String>()?),
+        "dict" => match to_toml(source, "") {
+            Ok(toml::Value::Table(table)) => Config::from_table(&table),
+            Ok(_) => return Err(PyValueError::new_err("config <dict> is not valid: not a dict")),
+            Err(e) => Err(e.in_source("<dict>")),
+        },
         _ => return Err(PyValueError::new_err(format!("unknown config kind {kind:?}"))),
     };
     parsed.map_err(config_error)
+}
+
+/// A Python value of a config dict at `field` as TOML: dicts, lists and tuples, booleans,
+/// integers, floats (NaN and infinities too, for the checks to name them) and strings; numpy
+/// scalars and arrays by their `tolist()`.
+fn to_toml(value: &Bound<'_, PyAny>, field: &str) -> Result<toml::Value, ConfigError> {
+    let invalid = |allowed: &str| ConfigError::Invalid {
+        field: field.to_string(),
+        value: value.repr().map_or_else(|_| "?".to_string(), |r| r.to_string()),
+        allowed: allowed.to_string(),
+    };
+    if let Ok(dict) = value.cast::<PyDict>() {
+        let mut table = toml::Table::new();
+        for (key, item) in dict.iter() {
+            let key: String = key.extract().map_err(|_| invalid("a dict with string keys"))?;
+            let inner = if field.is_empty() { key.clone() } else { format!("{field}.{key}") };
+            table.insert(key, to_toml(&item, &inner)?);
+        }
+        return Ok(toml::Value::Table(table));
+    }
+    if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
+        let items = value.try_iter().map_err(|_| invalid("a list"))?;
+        let values = items
+            .enumerate()
+            .map(|(i, item)| to_toml(&item.map_err(|_| invalid("a list"))?, &format!("{field}[{i}]")))
+            .collect::<Result<_, _>>()?;
+        return Ok(toml::Value::Array(values));
+    }
+    if value.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(value.is_truthy().map_err(|_| invalid("a boolean"))?));
+    }
+    if value.is_instance_of::<PyInt>() {
+        return value.extract().map(toml::Value::Integer).map_err(|_| invalid("an integer from -2^63 to 2^63 - 1"));
+    }
+    if value.is_instance_of::<PyFloat>() {
+        return value.extract().map(toml::Value::Float).map_err(|_| invalid("a number"));
+    }
+    if let Ok(text) = value.extract::<String>() {
+        return Ok(toml::Value::String(text));
+    }
+    match value.call_method0("tolist") {
+        Ok(plain) if !plain.is(value) => to_toml(&plain, field),
+        _ => Err(invalid("a number, a string, a boolean, a list or a dict (leave the key out for its default)")),
+    }
 }
 
 /// A finished run: its resolved configuration and the simulation's measurements.
@@ -70,7 +111,7 @@ struct NativeRun {
 #[pyo3(signature = (source, kind, paths=None, seed=None, threads=None, progress=false))]
 fn run(
     py: Python<'_>,
-    source: &str,
+    source: &Bound<'_, PyAny>,
     kind: &str,
     paths: Option<u64>,
     seed: Option<u64>,

@@ -53,19 +53,10 @@ _RUN_FILES = ("lobes.csv", "summary.csv", "run.json")
 _COMPARE_FILES = ("models.csv", "compare.csv")
 
 
-def _json_default(value):
-    """numpy scalars and arrays in a config dict, as plain Python values."""
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    raise TypeError(f"config dict: {value!r} of type {type(value).__name__} is not a TOML value")
-
-
 def _config_source(config):
     """The config as (text, kind) for the native parser: a dict, a path or TOML text."""
     if isinstance(config, dict):
-        return json.dumps(config, default=_json_default), "json"
+        return config, "dict"
     if isinstance(config, os.PathLike):
         return os.fspath(config), "path"
     if isinstance(config, str):
