@@ -87,20 +87,21 @@ models = ["single"]
 #[test]
 fn an_rgb_run_is_compared_with_single_scattering_on_every_channel() {
     // Three conductors (Schlick F0 0.2, 0.6, 1; gold; F = 1, whose channels are equal) at 0 and
-    // 60 deg, 10^6 photons: the order-1 lobe of every case and channel (18) is tested, none is
+    // 60 deg, 10^6 photons: the order-1 lobe of every case and channel is tested, the three equal
+    // channels of F = 1 once, as channel r (4 cases x 3 + 2 cases x 1 = 14 lobes), none is
     // rejected at the Sidak level of family level 0.01, and the albedos differ by less than 4
     // standard errors. A model that gave g and b channel r's Fresnel would be rejected there:
     // at 10^6 photons the Schlick channels' order-1 albedos differ by hundreds of standard errors.
     let dir = tempfile::tempdir().unwrap();
     let (out, stdout) = common::run_config(dir.path(), "rgb", RGB);
-    assert!(stdout.contains("single (exact oracle): 18 lobes"), "{stdout}");
+    assert!(stdout.contains("single (exact oracle): 14 lobes"), "{stdout}");
     let mut reader = csv::Reader::from_path(out.join("compare.csv")).unwrap();
     let headers = reader.headers().unwrap().clone();
     let col = |name: &str| headers.iter().position(|h| h == name).unwrap();
     let (case, channel, p, diff, albedo) =
         (col("case"), col("channel"), col("p_value"), col("albedo_diff_se"), col("albedo_model"));
     let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
-    let level = smithwalk::analysis::stats::sidak(0.01, 18);
+    let level = smithwalk::analysis::stats::sidak(0.01, 14);
     let mut lobes: Vec<(String, String)> = Vec::new();
     for r in &rows {
         let pv: f64 = r[p].parse().unwrap();
@@ -109,12 +110,46 @@ fn an_rgb_run_is_compared_with_single_scattering_on_every_channel() {
         lobes.push((r[case].to_string(), r[channel].to_string()));
     }
     lobes.sort();
-    let expected: Vec<(String, String)> =
-        (0..6).flat_map(|c| ["b", "g", "r"].map(|ch| (c.to_string(), ch.to_string()))).collect();
-    assert_eq!(lobes, expected, "one lobe per case and channel");
+    // Cases 0-3 (Schlick, gold) per channel, cases 4-5 (F = 1) once.
+    let expected: Vec<(String, String)> = (0..6)
+        .flat_map(|c| ["b", "g", "r"].map(|ch| (c.to_string(), ch.to_string())))
+        .filter(|(c, ch)| c.as_str() < "4" || ch == "r")
+        .collect();
+    assert_eq!(lobes, expected, "one lobe per case and channel of a per-channel material, one per one-valued case");
     // The Schlick conductor at normal incidence (case 0): its channels' model albedos rise with F0.
     let model_albedo = |ch: &str| -> f64 {
         rows.iter().find(|r| &r[case] == "0" && &r[channel] == ch).unwrap()[albedo].parse().unwrap()
     };
     assert!(model_albedo("r") < model_albedo("g") && model_albedo("g") < model_albedo("b"));
+}
+
+#[test]
+fn single_says_which_cases_it_skips_and_why() {
+    // A dielectric lit from outside and from inside at two angles: single scattering is given
+    // for light from outside alone, and the report says it skips the other 2 of the 4 cases.
+    let dir = tempfile::tempdir().unwrap();
+    let (_, stdout) = common::run_config(
+        dir.path(),
+        "sides",
+        r#"
+paths = 20_000
+seed = 23
+[surface]
+alpha = 0.5
+[material]
+kind = "dielectric"
+eta = 1.5
+[incident]
+theta_deg = [0, 40]
+side = ["outside", "inside"]
+[detector]
+cos_theta_bins = 4
+phi_bins = 8
+max_order = 2
+[compare]
+models = ["single"]
+"#,
+    );
+    assert!(stdout.contains("single (exact oracle): 4 lobes"), "{stdout}");
+    assert!(stdout.contains("  single: skips 2 of 4 cases: light from inside\n"), "{stdout}");
 }

@@ -30,7 +30,7 @@ use crate::analysis::compensation::{AlbedoCache, Compensation, compensated_bins}
 use crate::analysis::external::ExternalModel;
 use crate::analysis::models::{
     HammonFitPart, LobeIntegrals, MAX_BIN_EVALUATIONS, MAX_EXIT_BIN_EVALUATIONS, hammon_fit_lobe_bins,
-    single_scattering_lobe,
+    single_scattering_lobe, single_scattering_unavailable,
 };
 use crate::analysis::stats::{self, ChiSquare, WeightedBin};
 use crate::atomic::write_atomically;
@@ -192,10 +192,13 @@ fn folded_slot(config: &Config) -> Option<usize> {
     config.detector.max_order.map(|k| k as usize)
 }
 
-/// Whether a lobe is tested: with `max_order = 1` the "1+" slot is the all-orders lobe (slot 0)
-/// again, and one lobe is not tested twice.
-fn is_tested(config: &Config, order: usize) -> bool {
-    !(folded_slot(config) == Some(1) && order == 1)
+/// Whether a lobe (of `case`, order slot `order`, channel `channel`) is tested, so that no lobe
+/// is tested twice: with `max_order = 1` the "1+" slot is the all-orders lobe (slot 0) again; in
+/// an RGB run, a material with one value per parameter has the same walk weights in every
+/// channel, so its three channels are one lobe, tested once as channel `r` (a material given
+/// per channel is tested per channel).
+fn is_tested(config: &Config, case: &Case, order: usize, channel: usize) -> bool {
+    !(folded_slot(config) == Some(1) && order == 1) && (channel == 0 || case.material.is_rgb())
 }
 
 /// The closed-form models' lobes: `single` (order 1) and `hammon-fit` (order 1, folded into
@@ -263,6 +266,27 @@ fn closed_form(model: Model, run: &RunDir, measured: &Lobes, progress: &Progress
         }));
     }
     out
+}
+
+/// The note that a model skips some of the run's `cases`, with how many and why (`unavailable`
+/// gives a case's reason, `None` where the model applies): "skips 2 of 4 cases: light from
+/// inside", reasons in the order first met, each with its count when there are several; `None`
+/// when it skips none.
+fn skipped_cases(cases: &[Case], unavailable: fn(&Case) -> Option<&'static str>) -> Option<String> {
+    let mut reasons: Vec<(&str, usize)> = Vec::new();
+    for reason in cases.iter().filter_map(unavailable) {
+        match reasons.iter_mut().find(|r| r.0 == reason) {
+            Some(r) => r.1 += 1,
+            None => reasons.push((reason, 1)),
+        }
+    }
+    let skipped: usize = reasons.iter().map(|r| r.1).sum();
+    let why: Vec<String> = match &reasons[..] {
+        [] => return None,
+        [(reason, _)] => vec![(*reason).to_string()],
+        _ => reasons.iter().map(|(reason, n)| format!("{reason} ({n})")).collect(),
+    };
+    Some(format!("skips {skipped} of {} cases: {}", cases.len(), why.join(", ")))
 }
 
 /// The quadrature tolerance of every bin of a closed-form model's lobe (case, slot,
@@ -608,6 +632,11 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
                 let bar = model_progress(model, terminal);
                 let p = closed_form(model, &run, &measured, &bar);
                 bar.finish_and_clear();
+                if model == Model::Single
+                    && let Some(note) = skipped_cases(&run.cases, single_scattering_unavailable)
+                {
+                    notes.push((model, note));
+                }
                 p
             }
             Model::KullaConty | Model::Turquin | Model::FdezAguera => {
@@ -651,7 +680,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
             let h = hemisphere_name(lobe.hemisphere);
             let id: LobeId = (lobe.case, lobe.order, h.clone(), lobe.channel);
             let bins = measured.get(lobe.case, lobe.order, &h, lobe.channel).unwrap_or(&empty);
-            if !is_tested(&config, lobe.order) {
+            if !is_tested(&config, &run.cases[lobe.case], lobe.order, lobe.channel) {
                 continue;
             }
             let (test, rel_l1, rel_l2, albedo_model) = compare_lobe(bins, lobe, measured_photons, model_photons);
@@ -941,10 +970,24 @@ mod tests {
              [detector]\ncos_theta_bins = 2\nphi_bins = 2\nmax_order = 1\n",
         )
         .unwrap();
+        let case = &crate::setup::cases::expand(&config)[0];
         // max_order = 1: slot 1 is "1+" = slot 0, tested once, and `single` is skipped.
-        assert!(is_tested(&config, 0) && !is_tested(&config, 1));
+        assert!(is_tested(&config, case, 0, 0) && !is_tested(&config, case, 1, 0));
         config.detector.max_order = Some(2);
-        assert!(is_tested(&config, 1) && is_tested(&config, 2));
+        assert!(is_tested(&config, case, 1, 0) && is_tested(&config, case, 2, 0));
+    }
+
+    #[test]
+    fn the_equal_channels_of_a_one_valued_material_are_tested_once() {
+        let config: Config = toml::from_str(
+            "paths = 1000\n[surface]\nalpha = 0.5\n[[material]]\nkind = \"conductor\"\n\
+             [[material]]\nkind = \"conductor\"\nfresnel = \"schlick\"\nf0 = [0.2, 0.6, 1.0]\n\
+             [incident]\ntheta_deg = 0\n[detector]\ncos_theta_bins = 2\nphi_bins = 2\n",
+        )
+        .unwrap();
+        let cases = crate::setup::cases::expand(&config);
+        let tested = |case: &Case| (0..3).filter(|&c| is_tested(&config, case, 1, c)).count();
+        assert_eq!((tested(&cases[0]), tested(&cases[1])), (1, 3));
     }
 
     #[test]

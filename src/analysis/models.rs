@@ -205,6 +205,20 @@ pub fn single_scattering_bins(
     single_scattering_lobe(case, grid, hemisphere, channel, &|_| abs_tol).map(|lobe| lobe.energy)
 }
 
+/// Why single scattering is not available for `case` (the symmetric Smith Lambda, Hammon's
+/// normals, light from inside), or `None` where it is.
+pub fn single_scattering_unavailable(case: &Case) -> Option<&'static str> {
+    if case.smith != SmithKind::Exact {
+        Some("symmetric Smith Lambda")
+    } else if case.normals != NormalsKind::Vndf {
+        Some("Hammon's rejection normals")
+    } else if case.side != IncidentSide::Outside {
+        Some("light from inside")
+    } else {
+        None
+    }
+}
+
 /// [`single_scattering_bins`] with a tolerance per bin, `tolerance(bin)`, and the quadrature's
 /// error estimates and bound.
 pub fn single_scattering_lobe(
@@ -214,7 +228,7 @@ pub fn single_scattering_lobe(
     channel: usize,
     tolerance: &(dyn Fn(usize) -> f64 + Sync),
 ) -> Option<LobeIntegrals> {
-    if case.smith != SmithKind::Exact || case.normals != NormalsKind::Vndf || case.side != IncidentSide::Outside {
+    if single_scattering_unavailable(case).is_some() {
         return None;
     }
     let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
