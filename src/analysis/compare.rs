@@ -192,13 +192,15 @@ fn folded_slot(config: &Config) -> Option<usize> {
     config.detector.max_order.map(|k| k as usize)
 }
 
-/// Whether a lobe (of `case`, order slot `order`, channel `channel`) is tested, so that no lobe
-/// is tested twice: with `max_order = 1` the "1+" slot is the all-orders lobe (slot 0) again; in
-/// an RGB run, a material with one value per parameter has the same walk weights in every
-/// channel, so its three channels are one lobe, tested once as channel `r` (a material given
-/// per channel is tested per channel).
-fn is_tested(config: &Config, case: &Case, order: usize, channel: usize) -> bool {
-    !(folded_slot(config) == Some(1) && order == 1) && (channel == 0 || case.material.is_rgb())
+/// Whether `model`'s lobe (of `case`, order slot `order`, channel `channel`) is tested, so that
+/// no lobe is tested twice: with `max_order = 1` the "1+" slot is the all-orders lobe (slot 0)
+/// again; in an RGB run, a material with one value per parameter has the same walk weights in
+/// every channel, and so has every built-in model of it, so its three channels are one lobe,
+/// tested once as channel `r` (a material given per channel is tested per channel). A user's
+/// `--external` model may differ between channels whatever the material: all are tested.
+fn is_tested(config: &Config, case: &Case, model: Model, order: usize, channel: usize) -> bool {
+    let channel_of_its_own = channel == 0 || case.material.is_rgb() || model == Model::External;
+    !(folded_slot(config) == Some(1) && order == 1) && channel_of_its_own
 }
 
 /// The closed-form models' lobes: `single` (order 1) and `hammon-fit` (order 1, folded into
@@ -680,7 +682,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
             let h = hemisphere_name(lobe.hemisphere);
             let id: LobeId = (lobe.case, lobe.order, h.clone(), lobe.channel);
             let bins = measured.get(lobe.case, lobe.order, &h, lobe.channel).unwrap_or(&empty);
-            if !is_tested(&config, &run.cases[lobe.case], lobe.order, lobe.channel) {
+            if !is_tested(&config, &run.cases[lobe.case], model, lobe.order, lobe.channel) {
                 continue;
             }
             let (test, rel_l1, rel_l2, albedo_model) = compare_lobe(bins, lobe, measured_photons, model_photons);
@@ -972,9 +974,10 @@ mod tests {
         .unwrap();
         let case = &crate::setup::cases::expand(&config)[0];
         // max_order = 1: slot 1 is "1+" = slot 0, tested once, and `single` is skipped.
-        assert!(is_tested(&config, case, 0, 0) && !is_tested(&config, case, 1, 0));
+        let single = Model::Single;
+        assert!(is_tested(&config, case, single, 0, 0) && !is_tested(&config, case, single, 1, 0));
         config.detector.max_order = Some(2);
-        assert!(is_tested(&config, case, 1, 0) && is_tested(&config, case, 2, 0));
+        assert!(is_tested(&config, case, single, 1, 0) && is_tested(&config, case, single, 2, 0));
     }
 
     #[test]
@@ -986,8 +989,11 @@ mod tests {
         )
         .unwrap();
         let cases = crate::setup::cases::expand(&config);
-        let tested = |case: &Case| (0..3).filter(|&c| is_tested(&config, case, 1, c)).count();
-        assert_eq!((tested(&cases[0]), tested(&cases[1])), (1, 3));
+        let tested = |case: &Case, model| (0..3).filter(|&c| is_tested(&config, case, model, 1, c)).count();
+        assert_eq!((tested(&cases[0], Model::Single), tested(&cases[1], Model::Single)), (1, 3));
+        assert_eq!((tested(&cases[0], Model::HeitzNee), tested(&cases[1], Model::KullaConty)), (1, 3));
+        // A user's model may differ between channels where the walk does not.
+        assert_eq!((tested(&cases[0], Model::External), tested(&cases[1], Model::External)), (3, 3));
     }
 
     #[test]
