@@ -71,6 +71,9 @@ fn plot_writes_every_figure_and_a_report_that_shows_them() {
     assert_eq!(html.matches("measured from −z (positive on the refraction side").count(), 2, "T captions");
     assert_eq!(html.matches("measured from +z (positive on the mirror side").count(), 4, "R captions");
     assert!(html.contains("<th>theta_i_deg</th>") && html.contains("<th>alpha_x</th>"));
+    // The fourth row is the run's folded "3+" slot, said so, and the albedo caption is exact for it.
+    assert!(html.contains("own folded slot (max_order = 3)") && !html.contains("made by the plot"), "folded row");
+    assert!(html.contains("after 3 or more;"), "the albedo caption covers the folded slot");
     // The comparison: per model its lobes and verdict, and the worst lobes.
     assert!(html.contains("Models: single, wang-correlated."), "the header names the models");
     assert!(html.contains("<h2>Measurement against the models</h2>"));
@@ -169,4 +172,22 @@ fn a_wide_sweep_wraps_into_a_grid_of_panels() {
     let lobes = image::open(dir.path().join("lobes_g0_R.png")).unwrap();
     let (w, h) = (lobes.width() as f64, lobes.height() as f64);
     assert!(w < 1800.0 && h / w > 0.6, "{w} x {h}");
+}
+
+/// A dielectric lit from both sides without `max_order`: both groups name their side, and the
+/// "orders 4+" row reads as the plot's sum of the run's orders, not as a folded slot.
+#[test]
+fn both_sides_are_named_and_a_summed_row_is_told_from_a_folded_slot() {
+    let dir = tempfile::tempdir().unwrap();
+    let toml = "paths = 20000\nseed = 1\n[surface]\nalpha = 1.0\n[material]\nkind = \"dielectric\"\neta = 1.5\n[incident]\ntheta_deg = [0, 60]\nside = [\"outside\", \"inside\"]\n[detector]\ncos_theta_bins = 8\nphi_bins = 16\n";
+    run(toml, dir.path());
+    plot(dir.path(), &PlotOptions::default()).unwrap();
+    let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
+    for side in ["outside", "inside"] {
+        assert!(html.contains(&format!("<h2>GGX, α = 1, dielectric eta=1.5, light from {side}</h2>")), "{side}");
+    }
+    assert!(!html.contains("side inside"), "the side reads the same for both groups");
+    assert!(html.contains("made by the plot, of its orders 4 and higher, without error bars"), "summed row");
+    assert!(!html.contains("folded slot"), "no folded slot in a run without max_order");
+    assert!(html.contains("after 4 or more;") && html.contains("side the light comes from"), "albedo caption");
 }

@@ -9,7 +9,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::style::{self, CAPTION, FONT, Figure, Key, TICK, draw_err};
-use super::{Points, Row, Selection, bar_top, folded_note, groups, pretty_fields, row_label};
+use super::{Points, Row, Selection, bar_top, folded_note, groups, open_row, pretty_fields, row_label};
 use crate::io::rundir::{RunDir, SummaryRow};
 use crate::setup::cases::Case;
 
@@ -171,11 +171,14 @@ impl<'a> AlbedoFigure<'a> {
             Sweep::Theta => "the incident angle θ_i",
             Sweep::Alpha => "the roughness α (isotropic surfaces only)",
         };
+        let more = open_row(self.run, self.rows)
+            .map_or(String::new(), |(k, _)| format!(", or for \"orders {k}+\" after {k} or more"));
         format!(
             "Albedo per bounce order (the fraction of the incident energy that leaves in the hemisphere after exactly \
-             that many bounces; \"all orders\" is their sum) against {x}, one panel per surface, material and \
-             hemisphere. Bars: ±1 standard error (most are smaller than the markers).{}{}",
-            folded_note(self.rows, true),
+             that many bounces{more}; \"all orders\" is their sum) against {x}, one panel per combination of the \
+             other case parameters (surface, material, side the light comes from) and hemisphere. Bars: ±1 standard \
+             error (most are smaller than the markers).{}{}",
+            folded_note(self.run, self.rows, true),
             self.selection.note()
         )
     }

@@ -229,7 +229,7 @@ impl Figure for HeatFigure<'_> {
         let hemisphere = if self.hemisphere == "T" { "transmission" } else { "reflection" };
         let title = format!(
             "{}, θ_i = {:.1}°: f over the {hemisphere} hemisphere (light from +x){}",
-            surface_label(self.case),
+            surface_label(self.run, self.case),
             self.case.theta_i_deg,
             self.selection.suffix()
         );
@@ -261,9 +261,9 @@ impl HeatFigure<'_> {
              x = sin θ_o cos φ_o, y = sin θ_o sin φ_o with φ_o from the incident azimuth (the light comes from +x{mirror}). \
              Each pixel is interpolated between the centres of the detector bins around its direction (linearly in |cos θ_o| and φ_o; at the pole, the mean of the innermost ring), on {scale}.{}{}",
             self.case.index,
-            surface_label(self.case),
+            surface_label(self.run, self.case),
             self.case.theta_i_deg,
-            super::folded_note(self.rows, false),
+            super::folded_note(self.run, self.rows, false),
             self.selection.note(),
         )
     }

@@ -139,12 +139,12 @@ impl LobeFigure<'_> {
              row per bounce order and one column per incident angle θ_i. Black points: the random walk, each the \
              average over a detector bin ({} bins in |cos θ_o|, {:.1}° of azimuth), with ±1 standard-error \
              bars.{} {models}{}",
-            surface_label(self.cases[0]),
+            surface_label(self.run, self.cases[0]),
             self.axis(),
             self.positive_side(),
             g.cos_bins,
             360.0 / g.phi_bins as f64,
-            folded_note(self.rows, true),
+            folded_note(self.run, self.rows, true),
             self.selection.note(),
         )
     }
@@ -169,7 +169,7 @@ impl Figure for LobeFigure<'_> {
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
         let hemisphere = if self.hemisphere == "T" { "transmission (T)" } else { "reflection (R)" };
-        let title = format!("{}: {hemisphere}{}", surface_label(self.cases[0]), self.selection.suffix());
+        let title = format!("{}: {hemisphere}{}", surface_label(self.run, self.cases[0]), self.selection.suffix());
         let legend = self.legend();
         let x = format!("θ_o from {} (deg): + {} side, − light's side", self.axis(), self.positive_side());
         let labels = style::GridLabels { title: &title, legend: &legend, y: "f·|cos θ_o| (1/sr)", x: &x };

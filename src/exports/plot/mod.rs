@@ -144,18 +144,38 @@ fn row_bins<'a>(
     }
 }
 
-/// What a caption says about a row the figure sums (empty without one), and with `bars`, why
-/// that row has none.
-fn folded_note(rows: &[Row], bars: bool) -> String {
-    let Some(k) = rows.iter().find_map(|r| if let Row::From(k) = r { Some(k) } else { None }) else {
+/// The K of the row "orders K+" among `rows`, if there is one, and whether it is the run's
+/// folded slot (`max_order = K`) rather than a sum the figure makes.
+fn open_row(run: &RunDir, rows: &[Row]) -> Option<(usize, bool)> {
+    let folded = run.config.detector.max_order.map(|k| k as usize).filter(|&k| k > 0 && rows.contains(&Row::Slot(k)));
+    folded
+        .map(|k| (k, true))
+        .or_else(|| rows.iter().find_map(|r| if let Row::From(k) = r { Some((*k, false)) } else { None }))
+}
+
+/// What a caption says about the row "orders K+", if the figure has one (empty otherwise):
+/// whether it is the run's folded slot (`max_order = K`, tallied by the walk, with error bars)
+/// or a sum the figure makes of the run's orders K and higher, and with `bars`, why that sum has
+/// none.
+fn folded_note(run: &RunDir, rows: &[Row], bars: bool) -> String {
+    let Some((k, folded)) = open_row(run, rows) else {
         return String::new();
     };
+    if folded {
+        let with = if bars { ", with its standard errors" } else { "" };
+        return format!(
+            " \"orders {k}+\" is the run's own folded slot (max_order = {k}): the energy the walk tallied after {k} \
+             or more bounces{with}."
+        );
+    }
     let why = if bars {
         ", without error bars: lobes.csv and summary.csv have no covariances between orders (docs/figures.md)"
     } else {
         ""
     };
-    format!(" \"orders {k}+\" is the sum of the run's orders {k} and higher{why}.")
+    format!(
+        " \"orders {k}+\" is not a slot of the run but the sum, made by the plot, of its orders {k} and higher{why}."
+    )
 }
 
 /// How an order slot reads in figures and tables: "order k", "orders K+" for the run's folded
@@ -229,6 +249,7 @@ fn pretty_field(column: usize, value: &str) -> String {
         "theta_i_deg" => format!("θ_i = {:.1}°", value.parse::<f64>().unwrap_or(f64::NAN)),
         "phi_i_deg" => format!("φ_i = {value}°"),
         "material" => value.to_string(),
+        "side" => format!("light from {value}"),
         name => format!("{name} {value}"),
     }
 }
@@ -251,8 +272,9 @@ fn describe(fields: &[String], columns: &[usize]) -> Vec<String> {
 }
 
 /// A self-contained name of a case's surface and material (NDF, roughness, material, and the
-/// Smith, normals and side settings when they are not the defaults).
-fn surface_label(case: &Case) -> String {
+/// Smith and normals settings when they are not the defaults) and the side the light comes
+/// from, named when it is not outside or when the run has both sides.
+fn surface_label(run: &RunDir, case: &Case) -> String {
     let alpha = if case.alpha_x == case.alpha_y {
         format!("α = {}", case.alpha_x)
     } else {
@@ -260,10 +282,13 @@ fn surface_label(case: &Case) -> String {
     };
     let fields = case_fields(case);
     let mut label = format!("{}, {alpha}, {}", fields[1].to_uppercase(), fields[7]);
-    for (column, default) in [(5, "exact"), (6, "vndf"), (10, "outside")] {
+    for (column, default) in [(5, "exact"), (6, "vndf")] {
         if fields[column] != default {
             label.push_str(&format!(", {} {}", CASE_COLUMNS[column], fields[column]));
         }
+    }
+    if fields[10] != "outside" || varying(&run.cases).contains(&10) {
+        label.push_str(&format!(", {}", pretty_field(10, &fields[10])));
     }
     label
 }

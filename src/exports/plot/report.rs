@@ -241,7 +241,7 @@ pub(super) fn page(
         }
     }
     for section in sections {
-        let _ = writeln!(html, "<h2>{}</h2>", escape(&surface_label(section.cases[0])));
+        let _ = writeln!(html, "<h2>{}</h2>", escape(&surface_label(run, section.cases[0])));
         html.push_str("<table><tr><th>case</th>");
         for &c in &shown {
             let _ = write!(html, "<th>{}</th>", CASE_COLUMNS[c]);
