@@ -244,8 +244,8 @@ fn bench_precision(paths: u64, energy: &EnergyConfig) -> Result<()> {
     if paths < MIN_PRECISION_PATHS {
         bail!(
             "`--paths` = {paths} is not allowed with `--precision`: at least {MIN_PRECISION_PATHS} photons per \
-             case (fewer cannot resolve the third orders: an order no photon reached would read `-`, \
-             one without observed variance `exact`)"
+             case (the rarest albedos of the table carry about 5e-5 of the light: with fewer photons an order \
+             no photon reached would read `-`, one without observed variance `exact`)"
         );
     }
     // The cases' configurations with this policy and photon count are checked before the table
