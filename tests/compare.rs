@@ -153,3 +153,33 @@ models = ["single"]
     assert!(stdout.contains("single (exact oracle): 4 lobes"), "{stdout}");
     assert!(stdout.contains("  single: skips 2 of 4 cases: light from inside\n"), "{stdout}");
 }
+
+#[test]
+fn hammon_fit_says_which_cases_it_skips_and_why() {
+    // A Hammon facet and a conductor at one angle: Hammon's fit is given for the Hammon facet
+    // alone, and the report says it skips the other case.
+    let dir = tempfile::tempdir().unwrap();
+    let (_, stdout) = common::run_config(
+        dir.path(),
+        "materials",
+        r#"
+paths = 20_000
+seed = 29
+[surface]
+alpha = 0.5
+[[material]]
+kind = "hammon"
+[[material]]
+kind = "conductor"
+[incident]
+theta_deg = 30
+[detector]
+cos_theta_bins = 4
+phi_bins = 8
+max_order = 2
+[compare]
+models = ["hammon-fit"]
+"#,
+    );
+    assert!(stdout.contains("  hammon-fit: skips 1 of 2 cases: not a Hammon facet\n"), "{stdout}");
+}

@@ -30,7 +30,7 @@ use crate::analysis::compensation::{AlbedoCache, Compensation, compensated_bins}
 use crate::analysis::external::ExternalModel;
 use crate::analysis::models::{
     HammonFitPart, LobeIntegrals, MAX_BIN_EVALUATIONS, MAX_EXIT_BIN_EVALUATIONS, hammon_fit_lobe_bins,
-    single_scattering_lobe, single_scattering_unavailable,
+    hammon_fit_unavailable, single_scattering_lobe, single_scattering_unavailable,
 };
 use crate::analysis::stats::{self, ChiSquare, WeightedBin};
 use crate::atomic::write_atomically;
@@ -634,9 +634,11 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
                 let bar = model_progress(model, terminal);
                 let p = closed_form(model, &run, &measured, &bar);
                 bar.finish_and_clear();
-                if model == Model::Single
-                    && let Some(note) = skipped_cases(&run.cases, single_scattering_unavailable)
-                {
+                let unavailable = match model {
+                    Model::Single => single_scattering_unavailable,
+                    _ => hammon_fit_unavailable,
+                };
+                if let Some(note) = skipped_cases(&run.cases, unavailable) {
                     notes.push((model, note));
                 }
                 p

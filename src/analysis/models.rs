@@ -391,6 +391,22 @@ pub fn hammon_fit_bins(
     hammon_fit_lobe_bins(case, grid, part, channel, &|_| abs_tol).map(|lobe| lobe.energy)
 }
 
+/// Why Hammon's fit does not apply to `case` (it was fitted to Hammon facets on isotropic GGX
+/// lit from outside), or `None` where it does.
+pub fn hammon_fit_unavailable(case: &Case) -> Option<&'static str> {
+    if !matches!(case.material, MaterialConfig::Hammon { .. }) {
+        Some("not a Hammon facet")
+    } else if case.ndf != NdfKind::Ggx {
+        Some("not GGX")
+    } else if case.alpha_x != case.alpha_y {
+        Some("anisotropic")
+    } else if case.side != IncidentSide::Outside {
+        Some("light from inside")
+    } else {
+        None
+    }
+}
+
 /// [`hammon_fit_bins`] with a tolerance per bin and the quadrature's error estimates and bound.
 pub fn hammon_fit_lobe_bins(
     case: &Case,
@@ -400,7 +416,7 @@ pub fn hammon_fit_lobe_bins(
     tolerance: &(dyn Fn(usize) -> f64 + Sync),
 ) -> Option<LobeIntegrals> {
     let MaterialConfig::Hammon { f0, albedo, .. } = &case.material else { return None };
-    if case.ndf != NdfKind::Ggx || case.alpha_x != case.alpha_y || case.side != IncidentSide::Outside {
+    if hammon_fit_unavailable(case).is_some() {
         return None;
     }
     let (f0, albedo) = (f0.channel(channel), albedo.channel(channel));
