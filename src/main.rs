@@ -248,17 +248,17 @@ fn bench_precision(paths: u64, energy: &EnergyConfig) -> Result<()> {
              no photon reached would read `-`, one without observed variance `exact`)"
         );
     }
-    // The cases' configurations with this policy and photon count are checked before the table
-    // starts.
+    // Every case's configuration is made, and so checked, before the table starts.
     let cases = precision_cases();
-    for case in &cases {
-        precision_config(case, energy, paths).with_context(|| {
-            format!(
-                "the options `--paths {paths} --split {} --threshold {}` (every case's `paths` and `[energy]`)",
-                energy.split, energy.threshold
-            )
-        })?;
-    }
+    let configs =
+        cases.iter().map(|case| precision_config(case, energy, paths)).collect::<Result<Vec<_>>>().with_context(
+            || {
+                format!(
+                    "the options `--paths {paths} --split {} --threshold {}` (every case's `paths` and `[energy]`)",
+                    energy.split, energy.threshold
+                )
+            },
+        )?;
     let mut out = std::io::stdout().lock();
     let legend = format!(
         "[energy] split = {}, threshold = {}. Per albedo (orders 1, 2, 3 and all; R, T): CPU seconds on \
@@ -278,8 +278,8 @@ fn bench_precision(paths: u64, energy: &EnergyConfig) -> Result<()> {
     if !print_line(&mut out, &header)? {
         return Ok(());
     }
-    for case in &cases {
-        let (rate, albedos) = time_to_precision(case, energy, paths)?;
+    for (case, config) in cases.iter().zip(&configs) {
+        let (rate, albedos) = time_to_precision(case, config)?;
         let mut row = format!("{:<28} {rate:>12.3e}", format!("{} {} {}", case.material, case.alpha, case.theta));
         for a in albedos {
             let cell = match a {

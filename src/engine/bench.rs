@@ -10,7 +10,7 @@ use rustix::time::{ClockId, clock_gettime};
 
 use crate::engine::detector::Hemisphere;
 use crate::engine::simulate;
-use crate::setup::config::{Config, EnergyConfig};
+use crate::setup::config::{Config, EnergyConfig, parse_toml};
 
 /// The reference cases: (label, `[surface]` and `[material]` TOML, theta_i in degrees).
 pub const CASES: [(&str, &str, f64); 5] = [
@@ -156,12 +156,11 @@ pub fn precision_cases() -> Vec<PrecisionCase> {
 /// allowed.
 pub fn precision_config(case: &PrecisionCase, energy: &EnergyConfig, paths: u64) -> Result<Config> {
     let PrecisionCase { toml, alpha, theta, .. } = case;
-    // The case's own text is valid; the options are set and checked as fields, so that a NaN
-    // is refused by name like any other value instead of failing to parse as TOML.
-    let mut config = Config::parse(&format!(
-        "paths = 2\nseed = 1\n[surface]\nalpha = {alpha}\n[material]\n{toml}\n[incident]\ntheta_rad = {theta}\n[detector]\nmax_order = 4\n"
+    // The policy is set as a field, not written into the text, so that a NaN is refused by name
+    // like any other value instead of failing to parse as TOML; then everything is checked once.
+    let mut config: Config = parse_toml(&format!(
+        "paths = {paths}\nseed = 1\n[surface]\nalpha = {alpha}\n[material]\n{toml}\n[incident]\ntheta_rad = {theta}\n[detector]\nmax_order = 4\n"
     ))?;
-    config.paths = paths;
     config.energy = energy.clone();
     config.validate()?;
     Ok(config)
@@ -179,19 +178,14 @@ pub struct Precision {
 }
 
 /// Time to a relative standard error of 1% on the albedos of orders 1, 2, 3 and all, R then T,
-/// of one case on 1 thread under the split and roulette policy `energy`: smithwalk's
-/// per-photon variance (`stderr^2 N`) over its measured paths per CPU-second, against the
-/// reference's binomial variance `p (1 - p)` (it walks unit-weight photons with coin escapes)
-/// over its rate. `None` where no light goes. An error names the field if `energy` is not a
-/// valid `[energy]` table.
-pub fn time_to_precision(
-    case: &PrecisionCase,
-    energy: &EnergyConfig,
-    paths: u64,
-) -> Result<(f64, Vec<Option<Precision>>)> {
-    let config = precision_config(case, energy, paths)?;
+/// of `case` walked on 1 thread with its run configuration `config` ([`precision_config`]):
+/// smithwalk's per-photon variance (`stderr^2 N`) over its measured paths per CPU-second,
+/// against the reference's binomial variance `p (1 - p)` (it walks unit-weight photons with
+/// coin escapes) over its rate. `None` where no light goes.
+pub fn time_to_precision(case: &PrecisionCase, config: &Config) -> Result<(f64, Vec<Option<Precision>>)> {
+    let paths = config.paths;
     let cpu = process_cpu_time();
-    let sim = simulate(&config, Some(1), false)?;
+    let sim = simulate(config, Some(1), false)?;
     let rate = paths as f64 / (process_cpu_time() - cpu).as_secs_f64();
     let reference = case.reference_rate;
     let result = &sim.results[0];
@@ -235,7 +229,8 @@ mod tests {
         // variance), and the all-orders albedo (1, without variance) is exact.
         let n = 20_000;
         let case = case_of("conductor");
-        let (rate, albedos) = time_to_precision(&case, &EnergyConfig::default(), n).unwrap();
+        let (rate, albedos) =
+            time_to_precision(&case, &precision_config(&case, &EnergyConfig::default(), n).unwrap()).unwrap();
         let ratio = rate / case.reference_rate * (n - 1) as f64 / n as f64;
         for a in albedos[..3].iter().map(|a| a.expect("orders 1 to 3 reflect light")) {
             assert!((a.speedup / ratio - 1.0).abs() < 1e-9, "{} against {ratio}", a.speedup);
@@ -252,12 +247,13 @@ mod tests {
         // Fresnel weights and the gains differ from albedo to albedo.
         let (n, case) = (20_000, case_of("dielectric"));
         let unit = EnergyConfig { split: false, threshold: 0.0 };
-        let (rate, albedos) = time_to_precision(&case, &unit, n).unwrap();
+        let (rate, albedos) = time_to_precision(&case, &precision_config(&case, &unit, n).unwrap()).unwrap();
         let ratio = rate / case.reference_rate * (n - 1) as f64 / n as f64;
         for a in albedos.iter().map(|a| a.expect("a dielectric reflects and transmits every order")) {
             assert!((a.speedup / ratio - 1.0).abs() < 1e-9, "{} against {ratio}", a.speedup);
         }
-        let (rate, albedos) = time_to_precision(&case, &EnergyConfig::default(), n).unwrap();
+        let (rate, albedos) =
+            time_to_precision(&case, &precision_config(&case, &EnergyConfig::default(), n).unwrap()).unwrap();
         let ratio = rate / case.reference_rate * (n - 1) as f64 / n as f64;
         let speedups: Vec<f64> = albedos.iter().map(|a| a.unwrap().speedup / ratio).collect();
         assert!(speedups.iter().any(|s| (s - 1.0).abs() > 0.1), "split photons gain like unit ones: {speedups:?}");
