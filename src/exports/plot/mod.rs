@@ -391,16 +391,22 @@ pub fn plot(run_dir: &Path, options: &PlotOptions) -> Result<Vec<PathBuf>> {
 mod tests {
     use super::*;
 
-    #[test]
-    fn plane_of_incidence_puts_the_mirror_side_at_positive_angles() {
+    /// The run directory of the config `toml`, walked on 1 thread and written to a temporary
+    /// directory (kept alive by the first element).
+    fn written_run(toml: &str) -> (tempfile::TempDir, RunDir) {
         let dir = tempfile::tempdir().unwrap();
-        let config = crate::setup::config::Config::parse(
-            "paths = 10\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 30\n[detector]\ncos_theta_bins = 4\nphi_bins = 8\n",
-        )
-        .unwrap();
+        let config = crate::setup::config::Config::parse(toml).unwrap();
         let sim = crate::engine::simulate(&config, Some(1), false).unwrap();
         crate::io::output::write_outputs(&sim, &config, dir.path()).unwrap();
         let run = RunDir::open(dir.path()).unwrap();
+        (dir, run)
+    }
+
+    #[test]
+    fn plane_of_incidence_puts_the_mirror_side_at_positive_angles() {
+        let (_dir, run) = written_run(
+            "paths = 10\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 30\n[detector]\ncos_theta_bins = 4\nphi_bins = 8\n",
+        );
         // Energy 0.1 only in cos bin 2 (|cos| in [0.5, 0.75)), phi bin 4 (phi in [180, 225) deg).
         let mut bins = vec![BinValue::default(); 32];
         bins[2 * 8 + 4].energy = 0.1;
@@ -426,14 +432,9 @@ mod tests {
     /// minus orders 1 to 3, in both hemispheres; its standard errors are NaN (not drawn).
     #[test]
     fn the_summed_row_is_all_orders_minus_the_orders_above_it() {
-        let dir = tempfile::tempdir().unwrap();
-        let config = crate::setup::config::Config::parse(
+        let (_dir, run) = written_run(
             "paths = 20000\nseed = 5\n[surface]\nalpha = 0.8\n[material]\nkind = \"dielectric\"\neta = 1.5\n[incident]\ntheta_deg = 60\nside = \"inside\"\n[detector]\ncos_theta_bins = 4\nphi_bins = 8\n",
-        )
-        .unwrap();
-        let sim = crate::engine::simulate(&config, Some(1), false).unwrap();
-        crate::io::output::write_outputs(&sim, &config, dir.path()).unwrap();
-        let run = RunDir::open(dir.path()).unwrap();
+        );
         let measured = run.measured().unwrap();
         for hemisphere in ["R", "T"] {
             let highest = highest_slot(&measured, 0, hemisphere, 0);
