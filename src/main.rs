@@ -364,12 +364,13 @@ fn run(args: RunArgs) -> Result<()> {
 fn run_config(args: &RunArgs) -> Result<Config> {
     let mut config = Config::load(&args.config)?;
     if let Some(p) = args.paths {
+        // The file is valid (`load` checked it), so an error now is the option's.
         config.paths = p;
+        config.validate().map_err(|e| e.from_option("--paths"))?;
     }
     if let Some(s) = args.seed {
         config.seed = s;
     }
-    config.validate()?;
     smithwalk::engine::check_resources(&config, args.threads)?;
     note_threads(args.threads);
     if !(args.checkpoint_seconds.is_finite() && args.checkpoint_seconds > 0.0) {
@@ -471,9 +472,10 @@ fn default_out(config_path: &Path) -> PathBuf {
 fn lut(config_path: &Path, paths: Option<u64>, threads: Option<usize>, out: Option<PathBuf>) -> Result<()> {
     let mut config = LutConfig::load(config_path)?;
     if let Some(p) = paths {
+        // The file is valid (`load` checked it), so an error now is the option's.
         config.paths = p;
+        config.validate().map_err(|e| e.from_option("--paths"))?;
     }
-    config.validate()?;
     check_threads(threads)?;
     let out = out.unwrap_or_else(|| default_out(config_path));
     prepare_dir(&out)?;

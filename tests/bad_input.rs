@@ -200,7 +200,11 @@ fn limits_are_checked_before_any_work() {
     // Once a loop over every chunk of 10^19 photons, and minutes of spawning threads.
     let (code, e) = run(BASE, &["--paths", "10000000000000000000"]);
     assert_eq!(code, Some(1));
-    assert!(e.contains("`paths` = 10000000000000000000") && e.contains("10^15"), "{e}");
+    // Named as typed: the value came from the command line, not from the file.
+    assert!(e.contains("`--paths` = 10000000000000000000") && e.contains("10^15"), "{e}");
+    let (code, e) = run(BASE, &["--paths", "1"]);
+    assert_eq!(code, Some(1));
+    assert!(e.contains("`--paths` = 1 is not allowed") && e.contains("at least 2"), "{e}");
     let (code, e) = run(BASE, &["--threads", "100000"]);
     assert_eq!(code, Some(1));
     assert!(e.contains("`--threads` = 100000") && e.contains("at most 1024"), "{e}");

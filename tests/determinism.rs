@@ -189,8 +189,8 @@ fn sweeps_parse_unambiguously_and_round_trip() {
 #[test]
 fn bench_rejects_bad_counts_with_a_clear_error_and_no_table() {
     for (args, expect) in [
-        (["--paths", "0", "--repeats", "1"], ["`paths` = 0", "at least 2"]),
-        (["--paths", "1", "--repeats", "1"], ["`paths` = 1", "at least 2"]),
+        (["--paths", "0", "--repeats", "1"], ["`--paths` = 0", "at least 2"]),
+        (["--paths", "1", "--repeats", "1"], ["`--paths` = 1", "at least 2"]),
         (["--paths", "100", "--repeats", "0"], ["`--repeats` = 0", "at least 1"]),
     ] {
         let result = smithwalk(&[&["bench"][..], &args].concat());

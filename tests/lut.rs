@@ -175,7 +175,25 @@ fn bad_table_configs_name_the_field() {
         std::fs::write(&path, toml).unwrap();
         let err = LutConfig::load(&path).expect_err(toml).to_string();
         assert!(err.contains(field) && err.contains("not allowed"), "{toml}: {err}");
+        // Like a run's config, a table's names the file the value is in.
+        assert!(err.starts_with(&format!("config {} is not valid: ", path.display())), "{toml}: {err}");
     }
+}
+
+#[test]
+fn a_bad_photon_count_on_the_command_line_is_named_as_typed() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("t.toml");
+    std::fs::write(&path, "table = \"conductor\"\nmu = 2\nalpha = 2\npaths = 10\n").unwrap();
+    let out_dir = dir.path().join("out");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_smithwalk"))
+        .args(["lut", path.to_str().unwrap(), "--paths", "1", "--out", out_dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(e.contains("`--paths` = 1 is not allowed") && e.contains("at least 2"), "{e}");
+    assert!(!out_dir.exists(), "{e}");
 }
 
 /// The value of `quantity` at table index `i` as lut.csv wrote it.

@@ -26,11 +26,14 @@ pub const CASES: [(&str, &str, f64); 5] = [
 ];
 
 /// The run configuration of a reference case with `paths` photons and the default detector;
-/// an error if the run configuration does not allow that many photons.
+/// an error naming `--paths` if the run configuration does not allow that many photons.
 pub fn case_config(case: usize, paths: u64) -> Result<Config> {
     let (_, surface, theta) = CASES[case];
     let toml = format!("paths = {paths}\nseed = 1\n[surface]\n{surface}\n[incident]\ntheta_deg = {theta}\n");
-    Ok(Config::parse(&toml)?)
+    let config: Config = parse_toml(&toml)?;
+    // The cases are valid, so an error is the photon count's, which `--paths` gave.
+    config.validate().map_err(|e| e.from_option("--paths"))?;
+    Ok(config)
 }
 
 /// One measurement: throughput on `threads` threads.

@@ -111,7 +111,7 @@ impl LutConfig {
             .map_err(|cause| ConfigError::Read { path: path.display().to_string(), cause })?;
         let config: LutConfig = toml::from_str(&text)
             .map_err(|e| ConfigError::Parse { path: path.display().to_string(), message: e.to_string() })?;
-        config.validate()?;
+        config.validate().map_err(|e| e.in_source(&path.display().to_string()))?;
         Ok(config)
     }
 

@@ -607,6 +607,19 @@ impl ConfigError {
     }
 }
 
+impl ConfigError {
+    /// The error as caused by the command-line `option` that overrode its field: a value the
+    /// user typed on the command line is named as they typed it.
+    pub fn from_option(self, option: &str) -> Self {
+        match self {
+            ConfigError::Invalid { value, allowed, .. } => {
+                ConfigError::Invalid { field: option.into(), value, allowed }
+            }
+            e => e,
+        }
+    }
+}
+
 pub(crate) fn invalid(field: impl Into<String>, value: impl fmt::Display, allowed: impl Into<String>) -> ConfigError {
     ConfigError::Invalid { field: field.into(), value: value.to_string(), allowed: allowed.into() }
 }
