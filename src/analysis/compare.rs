@@ -566,6 +566,12 @@ fn cpu_seconds() -> f64 {
     t.tv_sec as f64 + 1e-9 * t.tv_nsec as f64
 }
 
+/// A p-value for the console, to three digits; one too small for f64 (which a lobe far from its
+/// model gives) as the bound it is, not as `0.00e0`.
+fn p_value_text(p: f64) -> String {
+    if p > 0.0 { format!("{p:.2e}") } else { "<1e-300".to_string() }
+}
+
 /// A number of `models.csv` to `digits` significant digits, and a zero as `0`: six for an
 /// energy (a closed-form model's bins are accurate to 0.05 of the measured standard error, a
 /// Monte Carlo model's to its own), three for a standard error (an error bar).
@@ -920,12 +926,12 @@ fn report(
             let channel = if rgb { channel_name(rgb, c.lobe.3) } else { "-" };
             let _ = writeln!(
                 out,
-                "  {:>5} {order:>5} {:>4} {channel:>3} {:>10.1} {:>6} {:>10.2e} {:>8.4} {:>8.4} {:>8.1} SE{}",
+                "  {:>5} {order:>5} {:>4} {channel:>3} {:>10.1} {:>6} {:>10} {:>8.4} {:>8.4} {:>8.1} SE{}",
                 c.lobe.0,
                 c.lobe.2,
                 c.test.statistic,
                 c.test.dof,
-                c.test.p_value,
+                p_value_text(c.test.p_value),
                 c.rel_l1,
                 c.rel_l2,
                 c.albedo_diff_se(),
@@ -966,6 +972,13 @@ fn report(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_p_value_below_f64s_range_is_printed_as_a_bound() {
+        assert_eq!(p_value_text(0.0), "<1e-300");
+        assert_eq!(p_value_text(5.25e-110), "5.25e-110");
+        assert_eq!(p_value_text(0.5), "5.00e-1");
+    }
 
     #[test]
     fn single_scattering_is_never_tested_against_a_slot_that_holds_other_orders() {
