@@ -35,6 +35,15 @@ pub fn fly(tau: f64, up: bool, rate: f64, e: f64) -> Flight {
     Flight { escapes: up && travelled > tau, tau: tau_hit, excess: e - rate * tau }
 }
 
+/// The probability that a ray going up with rate `lambda` (`Lambda` of its direction) leaves
+/// the microsurface from depth `tau` without another hit, `G1 = u^Lambda = e^{-Lambda tau}`
+/// (§2.2): 1 at the top (`tau = 0`, `u = 1`) whatever the rate, even the infinite one of a
+/// direction on the horizon, where the product `Lambda tau` has no value.
+#[inline]
+pub fn escape_probability(lambda: f64, tau: f64) -> f64 {
+    if tau == 0.0 { 1.0 } else { (-lambda * tau).exp() }
+}
+
 /// The optical depth of the same point seen from the other side of the heightfield (§4.3):
 /// `-ln(1 - u)` with `u = e^{-tau}`, evaluated without cancellation at either end.
 #[inline]

@@ -12,7 +12,7 @@ use glam::DVec3;
 use rand::Rng;
 
 use crate::facet::{Branch, Facet, Interaction, Side};
-use crate::height::other_side_depth;
+use crate::height::{escape_probability, other_side_depth};
 use crate::ndf::Ndf;
 use crate::normals::Normals;
 use crate::walk::{Loss, Observer};
@@ -37,10 +37,15 @@ where
 {
     let flip = |v: DVec3, s: Side| if s == Side::Outside { v } else { -v };
     let (w_own, wo_own) = (flip(-d, side), flip(wo, side));
+    if wo_own.z == 0.0 {
+        // Along the horizon light leaves into neither side: no escape from below the top, and
+        // a set of directions of measure zero at the top.
+        return ([0.0; C], side);
+    }
     let (crosses, exit_side, exit_tau) =
         if wo_own.z > 0.0 { (false, side, tau) } else { (true, side.other(), other_side_depth(tau)) };
     let up = flip(wo, exit_side);
-    let escape = (-ndf.lambda(up) * exit_tau).exp();
+    let escape = escape_probability(ndf.lambda(up), exit_tau);
     let phase = facet.phase(ndf, w_own, wo_own, side, crosses, rng);
     (phase.map(|p| p * escape), exit_side)
 }
@@ -95,7 +100,7 @@ impl<N: Ndf, F, O, R> NextEvent<'_, N, F, O, R> {
         if up.z.is_nan() || up.z <= 0.0 {
             return;
         }
-        let escape = (-self.ndf.lambda(up) * exit_tau).exp() / f64::from(self.samples);
+        let escape = escape_probability(self.ndf.lambda(up), exit_tau) / f64::from(self.samples);
         let deposit = std::array::from_fn(|i| beta[i] * branch.weight[i] * escape);
         self.sink.escape(order, exit_side, branch.dir, &deposit);
     }
@@ -128,6 +133,55 @@ where
         for _ in 0..left {
             let m = sign * self.normals.sample(self.ndf, sign * d, self.rng);
             self.scatter(order, tau, side, d, m, weight);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::facet::{Conductor, ConductorFresnel, Dielectric, Lambertian};
+    use crate::ndf::{Ggx, Roughness};
+    use rand::SeedableRng;
+
+    /// Horizontal and barely-above-horizon `wo` at depth 0, just below it and deep: the
+    /// escape probability is in [0, 1] (1 at depth 0, where every upward direction is
+    /// unmasked, §2.2; 0 exactly along the horizon below the top), never NaN or infinite.
+    #[test]
+    fn grazing_and_horizontal_directions_give_finite_contributions() {
+        let ndf = Ggx(Roughness { x: 0.5, y: 0.5 });
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(1);
+        let d = DVec3::new(0.3, 0.1, -1.0).normalize();
+        let subnormal = f64::MIN_POSITIVE / 4.0;
+        let outgoing = [
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, -0.0),
+            DVec3::new(1.0, 0.0, subnormal),
+            DVec3::new(1.0, 0.0, -subnormal),
+            DVec3::new(1.0, 0.0, 1e-300),
+        ];
+        for tau in [0.0, 1e-300, 0.3, 40.0] {
+            for wo in outgoing {
+                for side in [Side::Outside, Side::Inside] {
+                    let values = [
+                        contribution(
+                            &ndf,
+                            &Conductor::<1> { fresnel: ConductorFresnel::None },
+                            tau,
+                            side,
+                            d,
+                            wo,
+                            &mut rng,
+                        )
+                        .0,
+                        contribution(&ndf, &Lambertian { albedo: [1.0] }, tau, side, d, wo, &mut rng).0,
+                        contribution::<_, _, _, 1>(&ndf, &Dielectric { eta: 1.5 }, tau, side, d, wo, &mut rng).0,
+                    ];
+                    for v in values {
+                        assert!(v[0].is_finite() && v[0] >= 0.0, "tau {tau}, wo {wo}, {side:?}: {v:?}");
+                    }
+                }
+            }
         }
     }
 }
