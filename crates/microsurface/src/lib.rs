@@ -13,6 +13,7 @@
 //! * [`facet`]: the micro-BSDF of a single facet (conductor, dielectric, Lambertian, Hammon);
 //! * [`walk`]: the random walk of Heitz et al. 2016 that composes them;
 //! * [`single`]: exact single scattering, the walk's order-1 oracle;
+//! * [`beta`]: the Beta function of transmitted masking, exact towards the horizon;
 //! * [`slope`]: closed-form GGX masses and visible-normal probabilities of slope-space
 //!   polygons (exact histogram oracles);
 //! * [`nee`]: next-event estimation, a second estimator of the walk's lobes;
@@ -24,6 +25,7 @@
 //!
 //! Everything here is pure physics: no I/O, no threads, no binning.
 
+pub mod beta;
 pub mod chain;
 pub mod facet;
 pub mod fresnel;

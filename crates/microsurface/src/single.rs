@@ -3,10 +3,9 @@
 //! `f_1(wi, wo) |cos theta_o|` (§0), with `wi` towards the light and `wo` towards the
 //! detector, both pointing away from the surface, in the frame where the light is outside.
 
-use glam::DVec3;
-use statrs::function::gamma::ln_gamma;
-
+use crate::beta::beta;
 use crate::ndf::Ndf;
+use glam::DVec3;
 
 /// Height-correlated masking-shadowing of a reflection, `1 / (1 + Lambda_i + Lambda_o)` (§1.5).
 pub fn g2_reflection<N: Ndf>(ndf: &N, wi: DVec3, wo: DVec3) -> f64 {
@@ -16,8 +15,7 @@ pub fn g2_reflection<N: Ndf>(ndf: &N, wi: DVec3, wo: DVec3) -> f64 {
 /// Height-correlated masking-shadowing of a transmission, `B(1 + Lambda(wi), 1 + Lambda(-wo))`
 /// (§1.5; the Beta function).
 pub fn g2_transmission<N: Ndf>(ndf: &N, wi: DVec3, wo: DVec3) -> f64 {
-    let (a, b) = (1.0 + ndf.lambda(wi), 1.0 + ndf.lambda(-wo));
-    (ln_gamma(a) + ln_gamma(b) - ln_gamma(a + b)).exp()
+    beta(1.0 + ndf.lambda(wi), 1.0 + ndf.lambda(-wo))
 }
 
 /// Mirror-facet reflection (§5): `F(wi·h) D(h) G2 / (4 |wi_z|)` for `wi`, `wo` above the

@@ -12,8 +12,7 @@
 //! and a direction into the surface continues with probability 1. Both variants conserve
 //! energy exactly, and the correlated one reproduces exact single scattering (§6.3).
 
-use statrs::function::gamma::ln_gamma;
-
+use crate::beta::beta;
 use crate::chain::Visibility;
 
 /// The shadowing model of the chain (§6.3).
@@ -23,11 +22,6 @@ pub enum Shadowing {
     Correlated,
     /// Height-uncorrelated: escape with the separable masking `G1` of the leaving direction.
     Uncorrelated,
-}
-
-/// The Beta function `B(a, b)`.
-fn beta(a: f64, b: f64) -> f64 {
-    (ln_gamma(a) + ln_gamma(b) - ln_gamma(a + b)).exp()
 }
 
 impl Visibility for Shadowing {
