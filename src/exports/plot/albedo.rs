@@ -228,19 +228,28 @@ impl<'a> AlbedoFigure<'a> {
     }
 }
 
-impl Figure for AlbedoFigure<'_> {
-    fn size(&self) -> (u32, u32) {
-        style::grid_size(PANEL, self.grid(), &self.legend())
-    }
-
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
+impl AlbedoFigure<'_> {
+    fn labels(&self) -> style::GridLabels {
         let title = match self.sweep {
             Sweep::Theta => "Albedo per bounce order against the incident angle",
             Sweep::Alpha => "Albedo per bounce order against the roughness",
         };
-        let title = format!("{title}{}", self.selection.suffix());
-        let legend = self.legend();
-        let labels = style::GridLabels { title: &title, legend: &legend, y: "albedo", x: self.sweep.axis() };
+        style::GridLabels {
+            title: format!("{title}{}", self.selection.suffix()),
+            legend: self.legend(),
+            y: "albedo".to_string(),
+            x: self.sweep.axis().to_string(),
+        }
+    }
+}
+
+impl Figure for AlbedoFigure<'_> {
+    fn size(&self) -> (u32, u32) {
+        style::grid_size(PANEL, self.grid(), &self.labels())
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
+        let labels = self.labels();
         for (area, panel) in style::draw_grid(root, &labels, self.grid())?.iter().zip(&self.panels) {
             self.panel(area, panel)?;
         }

@@ -160,19 +160,25 @@ impl LobeFigure<'_> {
         let (cols, blocks) = wrap(self.cases.len());
         (cols, blocks * self.rows.len())
     }
+
+    fn labels(&self) -> style::GridLabels {
+        let hemisphere = if self.hemisphere == "T" { "transmission (T)" } else { "reflection (R)" };
+        style::GridLabels {
+            title: format!("{}: {hemisphere}{}", surface_label(self.run, self.cases[0]), self.selection.suffix()),
+            legend: self.legend(),
+            y: "f·|cos θ_o| (1/sr)".to_string(),
+            x: format!("θ_o from {} (deg): + {} side, − light's side", self.axis(), self.positive_side()),
+        }
+    }
 }
 
 impl Figure for LobeFigure<'_> {
     fn size(&self) -> (u32, u32) {
-        style::grid_size(PANEL, self.grid(), &self.legend())
+        style::grid_size(PANEL, self.grid(), &self.labels())
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
-        let hemisphere = if self.hemisphere == "T" { "transmission (T)" } else { "reflection (R)" };
-        let title = format!("{}: {hemisphere}{}", surface_label(self.run, self.cases[0]), self.selection.suffix());
-        let legend = self.legend();
-        let x = format!("θ_o from {} (deg): + {} side, − light's side", self.axis(), self.positive_side());
-        let labels = style::GridLabels { title: &title, legend: &legend, y: "f·|cos θ_o| (1/sr)", x: &x };
+        let labels = self.labels();
         let (cols, rows) = self.grid();
         let panels = style::draw_grid(root, &labels, (cols, rows))?;
         for (i, case) in self.cases.iter().enumerate() {

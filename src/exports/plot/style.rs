@@ -244,11 +244,11 @@ const GRID_LEFT: u32 = 30;
 const GRID_BOTTOM: u32 = 34;
 
 /// What a grid of panels says around them.
-pub struct GridLabels<'a> {
-    pub title: &'a str,
-    pub legend: &'a [(Key, String)],
-    pub y: &'a str,
-    pub x: &'a str,
+pub struct GridLabels {
+    pub title: String,
+    pub legend: Vec<(Key, String)>,
+    pub y: String,
+    pub x: String,
 }
 
 /// The height of the band above a grid `width` pixels wide: title and legend.
@@ -256,10 +256,18 @@ fn grid_top(legend: &[(Key, String)], width: u32) -> u32 {
     GRID_TOP + LEGEND_LINE * (legend_lines(legend, width).len() as u32 - 1)
 }
 
-/// The canvas size of a grid of `cols` x `rows` panels of `panel` pixels with its bands.
-pub fn grid_size(panel: (u32, u32), (cols, rows): (usize, usize), legend: &[(Key, String)]) -> (u32, u32) {
-    let width = GRID_LEFT + panel.0 * cols as u32;
-    (width, grid_top(legend, width) + panel.1 * rows as u32 + GRID_BOTTOM)
+/// The width in pixels of `text` at font size `size`.
+fn text_width(text: &str, size: u32) -> u32 {
+    (FONT, size).into_font().box_size(text).map_or(8 * text.chars().count() as u32, |(w, _)| w)
+}
+
+/// The canvas size of a grid of `cols` x `rows` panels of `panel` pixels with its bands: wider
+/// panels where the title or the x label would not fit above or below narrow ones (a single
+/// column).
+pub fn grid_size(panel: (u32, u32), (cols, rows): (usize, usize), labels: &GridLabels) -> (u32, u32) {
+    let texts = (text_width(&labels.title, TITLE) + 24).max(GRID_LEFT + text_width(&labels.x, LABEL) + 24);
+    let width = (GRID_LEFT + panel.0 * cols as u32).max(texts);
+    (width, grid_top(&labels.legend, width) + panel.1 * rows as u32 + GRID_BOTTOM)
 }
 
 /// Draws the title, the legend and the shared axis labels of a grid of panels, and returns
@@ -270,13 +278,13 @@ pub fn draw_grid<DB: DrawingBackend>(
     (cols, rows): (usize, usize),
 ) -> Result<Vec<DrawingArea<DB, Shift>>> {
     let (width, height) = root.dim_in_pixel();
-    let top = grid_top(labels.legend, width);
-    draw_centred(root, labels.title, (width as i32 / 2, 18), TITLE, false)?;
-    draw_legend(&root.margin(38, 0, 0, 0).shrink((0, 0), (width, top - 42)), labels.legend)?;
+    let top = grid_top(&labels.legend, width);
+    draw_centred(root, &labels.title, (width as i32 / 2, 18), TITLE, false)?;
+    draw_legend(&root.margin(38, 0, 0, 0).shrink((0, 0), (width, top - 42)), &labels.legend)?;
     let middle = (top + (height - top - GRID_BOTTOM) / 2) as i32;
-    draw_centred(root, labels.y, (GRID_LEFT as i32 / 2, middle), LABEL, true)?;
+    draw_centred(root, &labels.y, (GRID_LEFT as i32 / 2, middle), LABEL, true)?;
     let below = ((GRID_LEFT + (width - GRID_LEFT) / 2) as i32, (height - GRID_BOTTOM / 2) as i32);
-    draw_centred(root, labels.x, below, LABEL, false)?;
+    draw_centred(root, &labels.x, below, LABEL, false)?;
     Ok(root.margin(top, GRID_BOTTOM, GRID_LEFT, 0).split_evenly((rows, cols)))
 }
 
@@ -414,6 +422,32 @@ mod tests {
             assert!(widths[line.clone()].iter().sum::<i32>() <= 390, "{line:?} of {widths:?}");
         }
         assert_eq!(lines.iter().map(|l| l.len()).sum::<usize>(), 5);
-        assert!(grid_size((360, 260), (1, 1), &entries).1 > grid_size((360, 260), (4, 1), &entries).1);
+        let labels = |title: &str, x: &str| GridLabels {
+            title: title.to_string(),
+            legend: entries.iter().map(|(_, name)| (Key::Measured, name.clone())).collect(),
+            y: String::new(),
+            x: x.to_string(),
+        };
+        let short = labels("t", "x");
+        assert!(grid_size((360, 260), (1, 1), &short).1 > grid_size((360, 260), (4, 1), &short).1);
+    }
+
+    /// A single column of panels is widened to its title and x label (they were cut off), and
+    /// a grid wide enough for them keeps its panels' width.
+    #[test]
+    fn a_narrow_grid_is_as_wide_as_its_title_and_x_label() {
+        let long = "GGX, α = 0.5, conductor F=1: reflection (R), a title much wider than one panel";
+        let x = "θ_o from +z (deg): + mirror side, − light's side, a label wider than one panel";
+        let labels = |title: &str, x: &str| GridLabels {
+            title: title.into(),
+            legend: Vec::new(),
+            y: String::new(),
+            x: x.into(),
+        };
+        let (width, _) = grid_size((330, 250), (1, 5), &labels(long, "x"));
+        assert!(width >= text_width(long, TITLE) + 24 && width > 360, "{width}");
+        let (width, _) = grid_size((330, 250), (1, 5), &labels("t", x));
+        assert!(width >= GRID_LEFT + text_width(x, LABEL) + 24, "{width}");
+        assert_eq!(grid_size((330, 250), (4, 1), &labels(long, x)).0, GRID_LEFT + 4 * 330);
     }
 }
