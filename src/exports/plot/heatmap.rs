@@ -3,14 +3,21 @@
 //! light comes from +x), each panel with its colour bar, on a linear scale or (`--log`) over
 //! the three decades below its maximum.
 //!
-//! The detector's bins are uniform in |cos theta_o| and phi_o (equal projected solid angle,
-//! theory.md §4.7), so its innermost ring is a cap (theta_o up to 14.4 deg with 32 bins) cut
+//! The detector's bins are uniform in |cos theta_o| and phi_o (equal solid angle, theory.md
+//! §4.7), so its innermost ring is a cap (theta_o up to 14.4 deg with 32 bins) cut
 //! into thin wedges that meet at the pole. Painted flat, bin by bin, those wedges showed as a
 //! star of streaks around the centre, with a step at the cap's edge, that is not in the lobe.
 //! So every pixel is interpolated between bin centres instead: linearly in |cos theta_o| and
 //! (periodically) in phi_o, and inside the innermost ring's centres towards the pole's value,
-//! the mean of that ring (phi means nothing at the pole). Maxima and colour bars are the bins'
-//! own values.
+//! the mean of that ring (phi means nothing at the pole). Colour bars are in the bins' own
+//! values.
+//!
+//! A colour scale runs to the largest value the bins support ([`scale_top`]: a bin's f where
+//! it is measured to a relative standard error of at most [`RELIABLE`], else f less one
+//! standard error), not to the largest bin: near the horizon a bin's projected solid angle is tiny
+//! (63 times less at the rim than at the pole with 32 bins), so a single photon there has a
+//! huge f and, as the top of a linear scale, left the rest of a sparse order's panel blank.
+//! Bins above the scale, all noisy, are drawn in its top colour, and the panel says how many.
 
 use anyhow::Result;
 use plotters::coord::Shift;
@@ -33,6 +40,9 @@ const TOP: u32 = 44;
 const MAX_COLUMNS: usize = 3;
 /// Decades shown by a logarithmic colour scale.
 const DECADES: f64 = 3.0;
+/// The largest relative standard error of a bin that may set the top of a colour scale (a
+/// Poisson count of about 11 photons).
+const RELIABLE: f64 = 0.3;
 
 pub struct HeatFigure<'a> {
     pub run: &'a RunDir,
@@ -49,9 +59,21 @@ struct Scale {
     range: (f64, f64),
 }
 
+/// The top of a colour scale for `bins` with standard errors `stderr` (of f): the largest value
+/// the bins support, a bin measured to a relative standard error of at most [`RELIABLE`]
+/// counting with its f and a noisier one with f less one standard error (nothing for a bin of
+/// one photon); where no bin supports any value, the largest f.
+fn scale_top(bins: &[BinValue], stderr: &[f64]) -> f64 {
+    let finite = || bins.iter().zip(stderr).filter(|(b, _)| b.bsdf.is_finite());
+    let supported = |(b, se): (&BinValue, &f64)| if *se <= RELIABLE * b.bsdf { b.bsdf } else { b.bsdf - se };
+    let top = finite().map(supported).filter(|v| v.is_finite()).fold(0.0_f64, f64::max);
+    if top > 0.0 { top } else { finite().map(|(b, _)| b.bsdf).fold(0.0_f64, f64::max) }
+}
+
 impl Scale {
-    fn of(bins: &[BinValue], log: bool) -> Self {
-        let max = bins.iter().map(|b| b.bsdf).filter(|f| f.is_finite()).fold(0.0_f64, f64::max);
+    /// The scale of a panel whose colours run up to `max` (a linear scale from 0, or `DECADES`
+    /// decades below it).
+    fn up_to(max: f64, log: bool) -> Self {
         match (log, max > 0.0) {
             (true, true) => {
                 let top = max.log10();
@@ -101,6 +123,22 @@ fn colour(level: f64) -> RGBColor {
 }
 
 impl HeatFigure<'_> {
+    /// The standard errors of f in the bins of `row`: the bins' own, or for a row that sums
+    /// several slots (whose bins carry none, see `row_bins`) the sum of its slots' standard
+    /// errors, an upper bound whatever their correlation.
+    fn stderrs(&self, row: Row, bins: &[BinValue], highest: usize) -> Vec<f64> {
+        let (case, ch) = (self.case.index, self.selection.channel);
+        match row {
+            Row::From(k) if k < highest => (k..=highest)
+                .filter_map(|slot| self.measured.get(case, slot, self.hemisphere, ch))
+                .fold(vec![0.0; bins.len()], |mut sum, slot| {
+                    sum.iter_mut().zip(slot).for_each(|(s, b)| *s += b.bsdf_stderr);
+                    sum
+                }),
+            _ => bins.iter().map(|b| b.bsdf_stderr).collect(),
+        }
+    }
+
     fn panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, row: Row, log: bool) -> Result<()> {
         let ch = self.selection.channel;
         let highest = highest_slot(self.measured, self.case.index, self.hemisphere, ch);
@@ -108,10 +146,20 @@ impl HeatFigure<'_> {
             return Ok(());
         };
         let bins = &bins[..];
-        let scale = Scale::of(bins, log);
+        let top = scale_top(bins, &self.stderrs(row, bins, highest));
+        let scale = Scale::up_to(top, log);
+        let above = bins.iter().filter(|b| b.bsdf > top).count();
         let (caption, area) = area.split_vertically(CAPTION_HEIGHT);
         let (w, _) = caption.dim_in_pixel();
-        let label = if log { format!("{}, log scale", row_label(self.run, row)) } else { row_label(self.run, row) };
+        let mut label = row_label(self.run, row);
+        if log {
+            label += ", log scale";
+        }
+        match above {
+            0 => {}
+            1 => label += " (1 noisy bin above the scale)",
+            n => label += &format!(" ({n} noisy bins above the scale)"),
+        }
         style::draw_centred(&caption, &label, ((w - BAR) as i32 / 2, 14), CAPTION, false)?;
         let (map_area, bar_area) = area.split_horizontally(PANEL.0 - BAR);
         // A square plotting area, so that the disc is round.
@@ -163,15 +211,12 @@ impl HeatFigure<'_> {
             (0..=180).map(|k| (k as f64 * 2.0).to_radians()).map(|p| (p.cos(), p.sin())).collect();
         chart.draw_series(std::iter::once(PathElement::new(circle, BLACK.stroke_width(1)))).map_err(draw_err)?;
         if self.hemisphere == "R" && self.case.theta_i_deg > 0.0 {
-            // The mirror direction: theta_o = theta_i at phi_o = 180 deg.
+            // The mirror direction, theta_o = theta_i at phi_o = 180 deg, as a ring: a marker that
+            // covered it would hide the peak it marks (at grazing incidence, at the rim).
             let mirror = (-self.case.theta_i_deg.to_radians().sin(), 0.0);
-            let cross = |c: RGBColor, w: u32| {
-                EmptyElement::at(mirror)
-                    + PathElement::new(vec![(-6, 0), (6, 0)], c.stroke_width(w))
-                    + PathElement::new(vec![(0, -6), (0, 6)], c.stroke_width(w))
-            };
-            chart.plotting_area().draw(&cross(WHITE, 4)).map_err(draw_err)?;
-            chart.plotting_area().draw(&cross(BLACK, 2)).map_err(draw_err)?;
+            let ring = |c: RGBColor, w: u32| EmptyElement::at(mirror) + Circle::new((0, 0), 8, c.stroke_width(w));
+            chart.plotting_area().draw(&ring(WHITE, 4)).map_err(draw_err)?;
+            chart.plotting_area().draw(&ring(BLACK, 2)).map_err(draw_err)?;
         }
         // The colour bar, as tall as the map.
         let bar_top = MARGIN + (mh - 2 * MARGIN - X_AREA - ph) / 2;
@@ -247,19 +292,24 @@ impl HeatFigure<'_> {
     /// What the report says under the figure.
     pub fn caption(&self) -> String {
         let scale = if self.selection.log {
-            "a logarithmic colour scale over the three decades below each panel's maximum (lower values are dark blue)"
+            "a logarithmic colour scale over the three decades below its top (lower values are dark blue)"
         } else {
-            "a linear colour scale from 0 to each panel's maximum"
+            "a linear colour scale from 0 to its top"
         };
+        let top = "Each panel's scale tops at the largest value its bins support: a bin measured to a relative \
+                   standard error of at most 30% counts with its value, a noisier one with its value less one \
+                   standard error. Bins above the top, all noisy (near the horizon, where a bin's projected solid \
+                   angle is small, one photon makes a large f), are drawn in the top colour, and the panel's title \
+                   counts them.";
         let (hemisphere, mirror) = if self.hemisphere == "T" {
             ("transmission", "")
         } else {
-            ("reflection", "; the cross marks the mirror direction")
+            ("reflection", "; a ring marks the mirror direction")
         };
         format!(
             "Case {} ({}, θ_i = {:.1}°), {hemisphere}: the BSDF f (1/sr) per bounce order over the projected hemisphere, \
              x = sin θ_o cos φ_o, y = sin θ_o sin φ_o with φ_o from the incident azimuth (the light comes from +x{mirror}). \
-             Each pixel is interpolated between the centres of the detector bins around its direction (linearly in |cos θ_o| and φ_o; at the pole, the mean of the innermost ring), on {scale}.{}{}",
+             Each pixel is interpolated between the centres of the detector bins around its direction (linearly in |cos θ_o| and φ_o; at the pole, the mean of the innermost ring), on {scale}. {top}{}{}",
             self.case.index,
             surface_label(self.run, self.case),
             self.case.theta_i_deg,
@@ -299,16 +349,32 @@ mod tests {
 
     #[test]
     fn colour_scales_put_the_maximum_on_top() {
-        let bins = [0.0, 0.02, 2.0].map(|bsdf| BinValue { bsdf, ..BinValue::default() });
-        let linear = Scale::of(&bins, false);
+        let linear = Scale::up_to(2.0, false);
         assert_eq!((linear.level(2.0), linear.level(0.0), linear.level(1.0)), (1.0, 0.0, 0.5));
         // log10 2 = 0.301: the scale runs from 10^-3 to 2, a value of 0.02 sits 2 decades up.
-        let log = Scale::of(&bins, true);
+        let log = Scale::up_to(2.0, true);
         assert_eq!(log.range.0, -3.0);
         assert!((log.level(0.02) - (0.02f64.log10() + 3.0) / (2f64.log10() + 3.0)).abs() < 1e-12);
         assert_eq!(log.level(0.0), 0.0);
         assert_eq!(significant(0.001), "0.001");
         assert_eq!(significant(0.000316), "0.00032");
         assert_eq!(significant(25.0), "25");
+    }
+
+    /// A one-photon bin at the rim (relative standard error 1) does not set the scale; a
+    /// well-measured peak does, however narrow; a noisy bin counts with its value less one
+    /// standard error; with no support at all, the largest value does.
+    #[test]
+    fn a_noisy_bin_does_not_set_the_colour_scale() {
+        let bin = |bsdf: f64, relative: f64| (BinValue { bsdf, ..BinValue::default() }, relative * bsdf);
+        let top = |bins: &[(BinValue, f64)]| {
+            let (values, stderr): (Vec<BinValue>, Vec<f64>) = bins.iter().copied().unzip();
+            scale_top(&values, &stderr)
+        };
+        assert_eq!(top(&[bin(0.01, 0.1), bin(0.02, 0.2), bin(0.9, 1.0), bin(0.0, 0.0)]), 0.02);
+        assert_eq!(top(&[bin(0.01, 0.1), bin(5.0, 0.3), bin(0.9, 1.0)]), 5.0);
+        assert_eq!(top(&[bin(0.01, 0.5), bin(0.9, 1.0)]), 0.005);
+        assert_eq!(top(&[bin(0.9, 1.0), bin(0.4, 1.0)]), 0.9);
+        assert_eq!(top(&[bin(f64::NAN, 0.0), bin(0.2, 0.1)]), 0.2);
     }
 }
