@@ -350,6 +350,9 @@ pub fn build(config: &LutConfig, threads: Option<usize>, show_progress: bool) ->
 fn assemble(config: &LutConfig, sim: &Simulation) -> Lut {
     let (mu, alpha, eta, rule) = (config.mu_nodes(), config.alpha_nodes(), config.eta_nodes(), config.avg_rule());
     let sides = config.sides();
+    // The rule's weights add up to 1 up to rounding; dividing by their sum makes an albedo of
+    // exactly 1 at every node (a conductor's all orders) average to exactly 1.
+    let weights: f64 = rule.iter().map(|&(_, w)| w).sum();
     let (n_mu, n_all_mu, slices) = (mu.len(), mu.len() + rule.len(), eta.len().max(1));
     let case_index = |a: usize, e: usize, s: usize, m: usize| ((a * slices + e) * sides.len() + s) * n_all_mu + m;
     let mut tables = Vec::new();
@@ -371,8 +374,8 @@ fn assemble(config: &LutConfig, sim: &Simulation) -> Lut {
                     sum += w * value;
                     var += (w * se).powi(2);
                 }
-                avg.push(sum);
-                avg_stderr.push(var.sqrt());
+                avg.push(sum / weights);
+                avg_stderr.push(var.sqrt() / weights);
             }
         }
         tables.push(QuantityTable { quantity, e, e_stderr, avg, avg_stderr });
