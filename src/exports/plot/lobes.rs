@@ -11,7 +11,8 @@ use plotters::prelude::*;
 
 use super::style::{self, CAPTION, FONT, Figure, Key, MEASURED, TICK, draw_err};
 use super::{
-    Points, Row, Selection, bar_top, folded_note, highest_slot, plane_of_incidence, row_bins, row_label, surface_label,
+    Points, Row, Selection, all_orders_only, bar_top, folded_note, highest_slot, plane_of_incidence, row_bins,
+    row_label, surface_label,
 };
 use crate::io::rundir::{BinValue, Lobes, RunDir};
 use crate::setup::cases::Case;
@@ -133,12 +134,16 @@ impl LobeFigure<'_> {
         } else {
             "Lines: the models of models.csv, each in its fixed colour and dash (docs/figures.md).".to_string()
         };
+        let rows = if all_orders_only(self.rows) {
+            "all bounce orders together in one row"
+        } else {
+            "one row per bounce order"
+        };
         format!(
             "{}: the {hemisphere} lobe f·|cos θ_o| (1/sr) in the plane of incidence against the outgoing angle θ_o, \
-             measured from {} (positive on the {} side, φ_o = 180°; negative on the light's side, φ_o = 0°), one \
-             row per bounce order and one column per incident angle θ_i. Black points: the random walk, each the \
-             average over a detector bin ({} bins in |cos θ_o|, {:.1}° of azimuth), with ±1 standard-error \
-             bars.{} {models}{}",
+             measured from {} (positive on the {} side, φ_o = 180°; negative on the light's side, φ_o = 0°), {rows} \
+             and one column per incident angle θ_i. Black points: the random walk, each the average over a detector \
+             bin ({} bins in |cos θ_o|, {:.1}° of azimuth), with ±1 standard-error bars.{} {models}{}",
             surface_label(self.run, self.cases[0]),
             self.axis(),
             self.positive_side(),
