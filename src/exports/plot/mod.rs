@@ -407,7 +407,7 @@ mod tests {
 
     /// The run directory of the config `toml`, walked on 1 thread and written to a temporary
     /// directory (kept alive by the first element).
-    fn written_run(toml: &str) -> (tempfile::TempDir, RunDir) {
+    pub(super) fn written_run(toml: &str) -> (tempfile::TempDir, RunDir) {
         let dir = tempfile::tempdir().unwrap();
         let config = crate::setup::config::Config::parse(toml).unwrap();
         let sim = crate::engine::simulate(&config, Some(1), false).unwrap();
