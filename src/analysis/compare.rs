@@ -101,7 +101,7 @@ pub fn is_exact_oracle(model: Model) -> bool {
 
 /// Whether a model is estimated by a Monte Carlo walk (with its own standard errors), not
 /// integrated in closed form.
-fn is_monte_carlo(model: Model) -> bool {
+pub fn is_monte_carlo(model: Model) -> bool {
     matches!(model, Model::HeitzNee | Model::ExactPositionFree | Model::WangCorrelated | Model::WangUncorrelated)
 }
 

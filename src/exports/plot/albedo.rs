@@ -9,7 +9,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::style::{self, CAPTION, FONT, Figure, Key, TICK, draw_err};
-use super::{Points, Row, Selection, bar_top, folded_note, groups, open_row, pretty_fields, row_label};
+use super::{
+    Points, Row, Selection, all_orders_only, bar_top, folded_note, groups, open_row, pretty_fields, row_label,
+};
 use crate::io::rundir::{RunDir, SummaryRow};
 use crate::setup::cases::Case;
 
@@ -171,13 +173,20 @@ impl<'a> AlbedoFigure<'a> {
             Sweep::Theta => "the incident angle θ_i",
             Sweep::Alpha => "the roughness α (isotropic surfaces only)",
         };
-        let more = open_row(self.run, self.rows)
-            .map_or(String::new(), |(k, _)| format!(", or for \"orders {k}+\" after {k} or more"));
+        let what = if all_orders_only(self.rows) {
+            "Albedo of all bounce orders together (the fraction of the incident energy that leaves in the hemisphere)"
+                .to_string()
+        } else {
+            let more = open_row(self.run, self.rows)
+                .map_or(String::new(), |(k, _)| format!(", or for \"orders {k}+\" after {k} or more"));
+            format!(
+                "Albedo per bounce order (the fraction of the incident energy that leaves in the hemisphere after \
+                 exactly that many bounces{more}; \"all orders\" is their sum)"
+            )
+        };
         format!(
-            "Albedo per bounce order (the fraction of the incident energy that leaves in the hemisphere after exactly \
-             that many bounces{more}; \"all orders\" is their sum) against {x}, one panel per combination of the \
-             other case parameters (surface, material, side the light comes from) and hemisphere. Bars: ±1 standard \
-             error (most are smaller than the markers).{}{}",
+            "{what} against {x}, one panel per combination of the other case parameters (surface, material, side \
+             the light comes from) and hemisphere. Bars: ±1 standard error (most are smaller than the markers).{}{}",
             folded_note(self.run, self.rows, true),
             self.selection.note()
         )
@@ -230,12 +239,13 @@ impl<'a> AlbedoFigure<'a> {
 
 impl AlbedoFigure<'_> {
     fn labels(&self) -> style::GridLabels {
-        let title = match self.sweep {
-            Sweep::Theta => "Albedo per bounce order against the incident angle",
-            Sweep::Alpha => "Albedo per bounce order against the roughness",
+        let orders = if all_orders_only(self.rows) { "of all orders" } else { "per bounce order" };
+        let x = match self.sweep {
+            Sweep::Theta => "the incident angle",
+            Sweep::Alpha => "the roughness",
         };
         style::GridLabels {
-            title: format!("{title}{}", self.selection.suffix()),
+            title: format!("Albedo {orders} against {x}{}", self.selection.suffix()),
             legend: self.legend(),
             y: "albedo".to_string(),
             x: self.sweep.axis().to_string(),

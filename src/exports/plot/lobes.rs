@@ -11,13 +11,17 @@ use plotters::prelude::*;
 
 use super::style::{self, CAPTION, FONT, Figure, Key, MEASURED, TICK, draw_err};
 use super::{
-    Points, Row, Selection, bar_top, folded_note, highest_slot, plane_of_incidence, row_bins, row_label, surface_label,
+    Points, Row, Selection, all_orders_only, bar_top, folded_note, highest_slot, plane_of_incidence, row_bins,
+    row_label, surface_label,
 };
+use crate::analysis::compare::is_monte_carlo;
 use crate::io::rundir::{BinValue, Lobes, RunDir};
 use crate::setup::cases::Case;
-use crate::setup::config::IncidentSide;
+use crate::setup::config::{IncidentSide, Model};
 
 const PANEL: (u32, u32) = (330, 250);
+/// The opacity of a Monte Carlo model's ±1 standard-error band, in the model's colour.
+const BAND_OPACITY: f64 = 0.2;
 /// The most incident angles side by side before a sweep wraps into another block of rows.
 const MAX_COLUMNS: usize = 5;
 
@@ -36,6 +40,27 @@ pub struct LobeFigure<'a> {
 pub fn wrap(n: usize) -> (usize, usize) {
     let blocks = n.div_ceil(MAX_COLUMNS).max(1);
     (n.div_ceil(blocks).max(1), blocks)
+}
+
+/// Whether the model named `name` in models.csv is a Monte Carlo estimate (drawn with its
+/// standard-error band) rather than computed in closed form.
+fn is_monte_carlo_name(name: &str) -> bool {
+    Model::parse(name).is_ok_and(is_monte_carlo)
+}
+
+/// The ±1 standard-error band around a curve (x, y, standard error) as polygons, one per run of
+/// consecutive points with a finite standard error (a summed row has none), clamped to the
+/// axis' range `0..top`.
+fn bands(curve: &Points, top: f64) -> Vec<Vec<(f64, f64)>> {
+    curve
+        .chunk_by(|a, b| a.2.is_finite() == b.2.is_finite())
+        .filter(|run| run[0].2.is_finite())
+        .map(|run| {
+            let upper = run.iter().map(|&(x, y, e)| (x, (y + e).clamp(0.0, top)));
+            let lower = run.iter().rev().map(|&(x, y, e)| (x, (y - e).clamp(0.0, top)));
+            upper.chain(lower).collect()
+        })
+        .collect()
 }
 
 impl LobeFigure<'_> {
@@ -59,18 +84,20 @@ impl LobeFigure<'_> {
     fn panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, case: &Case, row: Row) -> Result<()> {
         let Some(bins) = self.bins(self.measured, case, row) else { return Ok(()) };
         let points = plane_of_incidence(self.run, &bins);
-        let lines: Vec<(style::LineStyle, Points)> = self
+        // Per model drawn: its style, its curve and whether it is a Monte Carlo estimate.
+        let lines: Vec<(style::LineStyle, Points, bool)> = self
             .models
             .iter()
             .filter_map(|(name, lobes)| {
-                self.bins(lobes, case, row)
-                    .map(|b| (style::model_style_by_name(name), plane_of_incidence(self.run, &b)))
+                self.bins(lobes, case, row).map(|b| {
+                    (style::model_style_by_name(name), plane_of_incidence(self.run, &b), is_monte_carlo_name(name))
+                })
             })
             .collect();
         let top = points
             .iter()
             .map(bar_top)
-            .chain(lines.iter().flat_map(|(_, l)| l.iter().map(|p| p.1)))
+            .chain(lines.iter().flat_map(|(_, l, _)| l.iter().map(|p| p.1)))
             .fold(0.0_f64, f64::max);
         let top = if top > 0.0 && top.is_finite() { 1.08 * top } else { 1.0 };
         let decimals = style::tick_decimals(0.0, top, 5);
@@ -94,7 +121,12 @@ impl LobeFigure<'_> {
             .y_label_formatter(&|v| style::tick(*v, decimals))
             .draw()
             .map_err(draw_err)?;
-        for (line, curve) in &lines {
+        // The Monte Carlo models' bands under every line, the lines under the walk's points.
+        for (line, curve, _) in lines.iter().filter(|l| l.2) {
+            let fill = line.colour.mix(BAND_OPACITY).filled();
+            chart.draw_series(bands(curve, top).into_iter().map(|b| Polygon::new(b, fill))).map_err(draw_err)?;
+        }
+        for (line, curve, _) in &lines {
             let curve: Vec<(f64, f64)> = curve.iter().map(|p| (p.0, p.1)).collect();
             style::draw_line(chart.plotting_area(), &curve, *line)?;
         }
@@ -128,17 +160,43 @@ impl LobeFigure<'_> {
     pub fn caption(&self) -> String {
         let g = self.run.grid;
         let hemisphere = if self.hemisphere == "T" { "transmitted" } else { "reflected" };
-        let models = if self.models_drawn().is_empty() {
+        let drawn = self.models_drawn();
+        let monte_carlo: Vec<&str> = drawn.iter().map(|m| m.as_str()).filter(|m| is_monte_carlo_name(m)).collect();
+        let bands = if monte_carlo.is_empty() {
+            String::new()
+        } else {
+            let summed = if self.rows.iter().any(|r| matches!(r, Row::From(_))) {
+                "; the summed row has none, for the reason its points have no error bars"
+            } else {
+                ""
+            };
+            let closed = if drawn.len() > monte_carlo.len() {
+                " The other models are computed in closed form: lines alone."
+            } else {
+                ""
+            };
+            format!(
+                " The Monte Carlo models ({}) are estimates with noise of their own, which makes their lines jump \
+                 from bin to bin in sparse lobes: the light band in a model's colour around its line is ±1 standard \
+                 error of its estimate (models.csv){summed}.{closed}",
+                monte_carlo.join(", ")
+            )
+        };
+        let models = if drawn.is_empty() {
             "No models (run `smithwalk compare` to draw them).".to_string()
         } else {
-            "Lines: the models of models.csv, each in its fixed colour and dash (docs/figures.md).".to_string()
+            format!("Lines: the models of models.csv, each in its fixed colour and dash (docs/figures.md).{bands}")
+        };
+        let rows = if all_orders_only(self.rows) {
+            "all bounce orders together in one row"
+        } else {
+            "one row per bounce order"
         };
         format!(
             "{}: the {hemisphere} lobe f·|cos θ_o| (1/sr) in the plane of incidence against the outgoing angle θ_o, \
-             measured from {} (positive on the {} side, φ_o = 180°; negative on the light's side, φ_o = 0°), one \
-             row per bounce order and one column per incident angle θ_i. Black points: the random walk, each the \
-             average over a detector bin ({} bins in |cos θ_o|, {:.1}° of azimuth), with ±1 standard-error \
-             bars.{} {models}{}",
+             measured from {} (positive on the {} side, φ_o = 180°; negative on the light's side, φ_o = 0°), {rows} \
+             and one column per incident angle θ_i. Black points: the random walk, each the average over a detector \
+             bin ({} bins in |cos θ_o|, {:.1}° of azimuth), with ±1 standard-error bars.{} {models}{}",
             surface_label(self.run, self.cases[0]),
             self.axis(),
             self.positive_side(),
@@ -194,6 +252,9 @@ impl Figure for LobeFigure<'_> {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+    use crate::exports::plot::tests::written_run;
+
     #[test]
     fn wide_sweeps_wrap_into_balanced_blocks() {
         assert_eq!(super::wrap(4), (4, 1));
@@ -201,5 +262,77 @@ mod tests {
         assert_eq!(super::wrap(6), (3, 2));
         assert_eq!(super::wrap(10), (5, 2));
         assert_eq!(super::wrap(11), (4, 3));
+    }
+
+    /// A band runs over consecutive points with a finite standard error: up along y + e, back
+    /// along y - e, clamped to the axis.
+    #[test]
+    fn bands_cover_runs_of_finite_errors_within_the_axis() {
+        let curve = vec![(-1.0, 0.5, 0.1), (0.0, 0.2, 0.3), (1.0, 0.9, f64::NAN), (2.0, 0.9, 0.2)];
+        let bands = bands(&curve, 1.0);
+        assert_eq!(bands.len(), 2);
+        assert_eq!(bands[0], [(-1.0, 0.6), (0.0, 0.5), (0.0, 0.0), (-1.0, 0.4)]);
+        assert_eq!(bands[1], [(2.0, 1.0), (2.0, 0.7)]);
+    }
+
+    /// Pixels of `png` within 2 of `colour` in every channel.
+    fn pixels_of(png: &[u8], colour: (f64, f64, f64)) -> usize {
+        let image = image::load_from_memory(png).unwrap().to_rgb8();
+        let near = |p: &image::Rgb<u8>| {
+            [colour.0, colour.1, colour.2].iter().zip(p.0).all(|(c, v)| (c - f64::from(v)).abs() <= 2.0)
+        };
+        image.pixels().filter(|p| near(p)).count()
+    }
+
+    /// A Monte Carlo model's line gets a light band of ±1 its standard error in its colour; a
+    /// closed-form model's line is drawn alone, whatever its standard errors; the caption says
+    /// which models have a band.
+    #[test]
+    fn monte_carlo_models_are_drawn_with_a_standard_error_band() {
+        let (_dir, run) = written_run(
+            "paths = 4000\nseed = 3\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 30\n[detector]\ncos_theta_bins = 8\nphi_bins = 16\nmax_order = 2\n",
+        );
+        let measured = run.measured().unwrap();
+        // A model: the measured lobes times `scale`, with a standard error of `error` of each bin.
+        let model = |scale: f64, error: f64| Lobes {
+            lobes: measured
+                .lobes
+                .iter()
+                .map(|(id, bins)| {
+                    let bins = bins
+                        .iter()
+                        .map(|b| BinValue { energy: scale * b.energy, energy_stderr: error * scale * b.energy, ..*b })
+                        .collect();
+                    (id.clone(), bins)
+                })
+                .collect(),
+        };
+        let cases: Vec<&Case> = run.cases.iter().collect();
+        let rows = super::super::rows(2);
+        let drawn = |single_error: f64| {
+            let models: BTreeMap<String, Lobes> =
+                [("heitz-nee".to_string(), model(1.0, 0.3)), ("single".to_string(), model(0.6, single_error))].into();
+            let figure = LobeFigure {
+                run: &run,
+                cases: &cases,
+                hemisphere: "R",
+                selection: Selection { channel: 0, rgb: false, log: false },
+                measured: &measured,
+                models: &models,
+                rows: &rows,
+            };
+            (style::render(&figure, style::Format::Png).unwrap(), figure.caption())
+        };
+        let (png, caption) = drawn(0.3);
+        // A band over white: 0.2 of the model's colour, 0.8 of white.
+        let mix = |v: u8| BAND_OPACITY * f64::from(v) + (1.0 - BAND_OPACITY) * 255.0;
+        let blue = style::model_style(Model::HeitzNee).colour;
+        let band = pixels_of(&png, (mix(blue.0), mix(blue.1), mix(blue.2)));
+        assert!(band > 5000, "heitz-nee's band: {band} pixels");
+        assert!(png == drawn(0.0).0, "single's standard errors change the figure");
+        assert!(
+            caption.contains("Monte Carlo models (heitz-nee)") && caption.contains("±1 standard error"),
+            "{caption}"
+        );
     }
 }

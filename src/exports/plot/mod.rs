@@ -96,15 +96,24 @@ pub(crate) enum Row {
 
 /// The rows of a run whose highest order slot is `highest`, in plotting order: 1, 2, ... up to
 /// [`ORDER_ROWS`], the last of them "K+" (the sum of every order from K up) when the run has
-/// more, then all orders.
+/// more, then all orders. A run with one order slot gets the all-orders row only: its slot 1
+/// holds the same lobe as slot 0 (the "1+" slot of `max_order = 1`, which `smithwalk compare`
+/// also tests once, as slot 0; or order 1 where no light bounced twice).
 fn rows(highest: usize) -> Vec<Row> {
     let mut out: Vec<Row> = if highest > ORDER_ROWS {
         (1..ORDER_ROWS).map(Row::Slot).chain([Row::From(ORDER_ROWS)]).collect()
-    } else {
+    } else if highest > 1 {
         (1..=highest).map(Row::Slot).collect()
+    } else {
+        Vec::new()
     };
     out.push(Row::Slot(0));
     out
+}
+
+/// Whether `rows` is the all-orders row alone (a run with one order slot, see [`rows`]).
+fn all_orders_only(rows: &[Row]) -> bool {
+    rows == [Row::Slot(0)]
 }
 
 /// The highest order slot of the lobes of one case, hemisphere and channel (0 if none).
@@ -156,8 +165,13 @@ fn open_row(run: &RunDir, rows: &[Row]) -> Option<(usize, bool)> {
 /// What a caption says about the row "orders K+", if the figure has one (empty otherwise):
 /// whether it is the run's folded slot (`max_order = K`, tallied by the walk, with error bars)
 /// or a sum the figure makes of the run's orders K and higher, and with `bars`, why that sum has
-/// none.
+/// none; with `max_order = 1`, that the run's "1+" slot is drawn once, as all orders.
 fn folded_note(run: &RunDir, rows: &[Row], bars: bool) -> String {
+    if all_orders_only(rows) && run.config.detector.max_order == Some(1) {
+        return " The run tallies every order in one slot (max_order = 1), \"orders 1+\", which is the all-orders \
+                lobe: it is drawn once, as \"all orders\"."
+            .to_string();
+    }
     let Some((k, folded)) = open_row(run, rows) else {
         return String::new();
     };
@@ -393,7 +407,7 @@ mod tests {
 
     /// The run directory of the config `toml`, walked on 1 thread and written to a temporary
     /// directory (kept alive by the first element).
-    fn written_run(toml: &str) -> (tempfile::TempDir, RunDir) {
+    pub(super) fn written_run(toml: &str) -> (tempfile::TempDir, RunDir) {
         let dir = tempfile::tempdir().unwrap();
         let config = crate::setup::config::Config::parse(toml).unwrap();
         let sim = crate::engine::simulate(&config, Some(1), false).unwrap();
@@ -426,6 +440,37 @@ mod tests {
         assert_eq!(rows(5), rows(13));
         assert_eq!(rows(4), [Row::Slot(1), Row::Slot(2), Row::Slot(3), Row::Slot(4), Row::Slot(0)]);
         assert_eq!(rows(2), [Row::Slot(1), Row::Slot(2), Row::Slot(0)]);
+    }
+
+    /// With `max_order = 1` the run's "1+" slot is the all-orders lobe: every figure draws it once,
+    /// as "all orders", and no caption speaks of other orders or of a sum.
+    #[test]
+    fn a_run_with_one_order_slot_draws_the_all_orders_lobe_once() {
+        let (_dir, run) = written_run(
+            "paths = 200\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = [0, 30]\n[detector]\ncos_theta_bins = 4\nphi_bins = 8\nmax_order = 1\n",
+        );
+        let measured = run.measured().unwrap();
+        assert_eq!(highest_slot(&measured, 0, "R", 0), 1);
+        let rows = rows(1);
+        assert_eq!(rows, [Row::Slot(0)]);
+        let selection = Selection { channel: 0, rgb: false, log: false };
+        let summary = run.summary().unwrap();
+        let albedo = albedo::AlbedoFigure::new(&run, &summary, albedo::Sweep::Theta, selection, &rows).unwrap();
+        let cases: Vec<&Case> = run.cases.iter().collect();
+        let models = BTreeMap::new();
+        let lobe = lobes::LobeFigure {
+            run: &run,
+            cases: &cases,
+            hemisphere: "R",
+            selection,
+            measured: &measured,
+            models: &models,
+            rows: &rows,
+        };
+        for caption in [albedo.caption(), lobe.caption(), folded_note(&run, &rows, false)] {
+            assert!(caption.contains("drawn once, as \"all orders\""), "{caption}");
+            assert!(!caption.contains("their sum") && !caption.contains("per bounce order"), "{caption}");
+        }
     }
 
     /// The summed "4+" row of a run without `max_order` holds, bin by bin, the all-orders lobe
