@@ -202,8 +202,8 @@ impl<'a> AlbedoFigure<'a> {
             .caption(caption, (FONT, CAPTION))
             .margin(6)
             .margin_right(14)
-            .x_label_area_size(26)
-            .y_label_area_size(52)
+            .x_label_area_size(30)
+            .y_label_area_size(64)
             .build_cartesian_2d(lo - pad..hi + pad, 0.0..top)
             .map_err(draw_err)?;
         chart

@@ -30,13 +30,13 @@ use crate::engine::detector::Grid;
 use crate::io::rundir::{BinValue, Lobes, RunDir};
 use crate::setup::cases::Case;
 
-const PANEL: (u32, u32) = (420, 340);
-const BAR: u32 = 96;
+const PANEL: (u32, u32) = (440, 360);
+const BAR: u32 = 110;
 const MARGIN: u32 = 8;
-const X_AREA: u32 = 46;
-const Y_AREA: u32 = 58;
-const CAPTION_HEIGHT: u32 = 26;
-const TOP: u32 = 44;
+const X_AREA: u32 = 54;
+const Y_AREA: u32 = 68;
+const CAPTION_HEIGHT: u32 = 30;
+const TOP: u32 = 50;
 const MAX_COLUMNS: usize = 3;
 /// Decades shown by a logarithmic colour scale.
 const DECADES: f64 = 3.0;
@@ -157,10 +157,10 @@ impl HeatFigure<'_> {
         }
         match above {
             0 => {}
-            1 => label += " (1 noisy bin above the scale)",
-            n => label += &format!(" ({n} noisy bins above the scale)"),
+            1 => label += " (1 bin above scale)",
+            n => label += &format!(" ({n} bins above scale)"),
         }
-        style::draw_centred(&caption, &label, ((w - BAR) as i32 / 2, 14), CAPTION, false)?;
+        style::draw_centred(&caption, &label, ((w - BAR) as i32 / 2, 16), CAPTION, false)?;
         let (map_area, bar_area) = area.split_horizontally(PANEL.0 - BAR);
         // A square plotting area, so that the disc is round.
         let (mw, mh) = map_area.dim_in_pixel();
@@ -241,7 +241,7 @@ impl HeatFigure<'_> {
         let (bx, by) =
             (bar_chart.plotting_area().get_pixel_range().0.start, bar_chart.plotting_area().get_pixel_range().1.start);
         let (ax, ay) = (area.get_base_pixel().0, area.get_base_pixel().1);
-        style::draw_centred(&area, "f (1/sr)", (bx - ax + bw as i32 / 2 + 6, by - ay - 12), TICK, false)?;
+        style::draw_centred(&area, "f (1/sr)", (bx - ax + bw as i32 / 2 + 6, by - ay - 14), TICK, false)?;
         let mut gradient = vec![0u8; (bw * bh * 3) as usize];
         for py in 0..bh {
             let c = colour(1.0 - (py as f64 + 0.5) / bh as f64);
@@ -264,23 +264,20 @@ fn significant(x: f64) -> String {
 }
 
 impl Figure for HeatFigure<'_> {
+    /// The panels' grid, widened where the title would not fit above it (a single panel); the
+    /// panels keep their width, centred.
     fn size(&self) -> (u32, u32) {
         let (cols, rows) = self.grid();
-        (PANEL.0 * cols as u32, TOP + PANEL.1 * rows as u32)
+        let width = (PANEL.0 * cols as u32).max(style::text_width(&self.title(), TITLE - 2) + 24);
+        (width, TOP + PANEL.1 * rows as u32)
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
         let (width, _) = self.size();
-        let hemisphere = if self.hemisphere == "T" { "transmission" } else { "reflection" };
-        let title = format!(
-            "{}, θ_i = {:.1}°: f over the {hemisphere} hemisphere (light from +x){}",
-            surface_label(self.run, self.case),
-            self.case.theta_i_deg,
-            self.selection.suffix()
-        );
-        style::draw_centred(root, &title, (width as i32 / 2, TOP as i32 / 2), TITLE - 2, false)?;
+        style::draw_centred(root, &self.title(), (width as i32 / 2, TOP as i32 / 2), TITLE - 2, false)?;
         let (cols, rows) = self.grid();
-        let panels = root.margin(TOP, 0, 0, 0).split_evenly((rows, cols));
+        let side = (width - PANEL.0 * cols as u32) / 2;
+        let panels = root.margin(TOP, 0, side, side).split_evenly((rows, cols));
         for (area, &row) in panels.iter().zip(self.rows) {
             self.panel(area, row, self.selection.log)?;
         }
@@ -289,6 +286,16 @@ impl Figure for HeatFigure<'_> {
 }
 
 impl HeatFigure<'_> {
+    fn title(&self) -> String {
+        let hemisphere = if self.hemisphere == "T" { "transmission" } else { "reflection" };
+        format!(
+            "{}, θ_i = {:.1}°: f over the {hemisphere} hemisphere (light from +x){}",
+            surface_label(self.run, self.case),
+            self.case.theta_i_deg,
+            self.selection.suffix()
+        )
+    }
+
     /// What the report says under the figure.
     pub fn caption(&self) -> String {
         let scale = if self.selection.log {
@@ -300,7 +307,7 @@ impl HeatFigure<'_> {
                    standard error of at most 30% counts with its value, a noisier one with its value less one \
                    standard error. Bins above the top, all noisy (near the horizon, where a bin's projected solid \
                    angle is small, one photon makes a large f), are drawn in the top colour, and the panel's title \
-                   counts them.";
+                   counts them (\"bins above scale\").";
         let (hemisphere, mirror) = if self.hemisphere == "T" {
             ("transmission", "")
         } else {

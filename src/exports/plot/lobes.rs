@@ -106,8 +106,8 @@ impl LobeFigure<'_> {
             .caption(caption, (FONT, CAPTION))
             .margin(6)
             .margin_right(14)
-            .x_label_area_size(26)
-            .y_label_area_size(56)
+            .x_label_area_size(30)
+            .y_label_area_size(70)
             .build_cartesian_2d((-90.0..90.001).step(30.0), 0.0..top)
             .map_err(draw_err)?;
         chart

@@ -13,12 +13,13 @@ use plotters::style::{FontTransform, text_anchor};
 use crate::setup::config::Model;
 
 pub const FONT: &str = "sans-serif";
-/// Text sizes in pixels, chosen so that a figure scaled to a 1000-pixel-wide page keeps its
-/// tick labels at 10 pixels or more.
-pub const TITLE: u32 = 22;
-pub const CAPTION: u32 = 16;
-pub const LABEL: u32 = 17;
-pub const TICK: u32 = 14;
+/// Text sizes as plotters takes them. plotters draws a font of size `s` with an em of `s / 1.24`
+/// pixels (its SVG output writes `font-size="s/1.24"`), so these give 22, 17, 18 and 15 pixel
+/// fonts: tick labels of 15 pixels are 9 at 1000 pixels of a 1680-pixel figure of five columns.
+pub const TITLE: u32 = 27;
+pub const CAPTION: u32 = 21;
+pub const LABEL: u32 = 22;
+pub const TICK: u32 = 19;
 
 /// The measurement: black points with one-standard-error bars.
 pub const MEASURED: RGBColor = BLACK;
@@ -168,7 +169,7 @@ pub enum Key {
 }
 
 /// The distance between the lines of a legend that wraps.
-const LEGEND_LINE: u32 = 24;
+const LEGEND_LINE: u32 = 28;
 
 /// The width in pixels each legend entry takes: line sample, gap, text and the space to the
 /// next entry.
@@ -239,9 +240,9 @@ pub fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, entries: &
 
 /// Bands around a grid of panels: the title and a one-line legend above (each further legend
 /// line adds [`LEGEND_LINE`]), the y label shared by the grid on the left and the x label below.
-const GRID_TOP: u32 = 78;
-const GRID_LEFT: u32 = 30;
-const GRID_BOTTOM: u32 = 34;
+const GRID_TOP: u32 = 90;
+const GRID_LEFT: u32 = 34;
+const GRID_BOTTOM: u32 = 40;
 
 /// What a grid of panels says around them.
 pub struct GridLabels {
@@ -257,7 +258,7 @@ fn grid_top(legend: &[(Key, String)], width: u32) -> u32 {
 }
 
 /// The width in pixels of `text` at font size `size`.
-fn text_width(text: &str, size: u32) -> u32 {
+pub fn text_width(text: &str, size: u32) -> u32 {
     (FONT, size).into_font().box_size(text).map_or(8 * text.chars().count() as u32, |(w, _)| w)
 }
 
@@ -279,8 +280,8 @@ pub fn draw_grid<DB: DrawingBackend>(
 ) -> Result<Vec<DrawingArea<DB, Shift>>> {
     let (width, height) = root.dim_in_pixel();
     let top = grid_top(&labels.legend, width);
-    draw_centred(root, &labels.title, (width as i32 / 2, 18), TITLE, false)?;
-    draw_legend(&root.margin(38, 0, 0, 0).shrink((0, 0), (width, top - 42)), &labels.legend)?;
+    draw_centred(root, &labels.title, (width as i32 / 2, 20), TITLE, false)?;
+    draw_legend(&root.margin(42, 0, 0, 0).shrink((0, 0), (width, top - 46)), &labels.legend)?;
     let middle = (top + (height - top - GRID_BOTTOM) / 2) as i32;
     draw_centred(root, &labels.y, (GRID_LEFT as i32 / 2, middle), LABEL, true)?;
     let below = ((GRID_LEFT + (width - GRID_LEFT) / 2) as i32, (height - GRID_BOTTOM / 2) as i32);
