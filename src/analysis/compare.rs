@@ -572,6 +572,13 @@ fn p_value_text(p: f64) -> String {
     if p > 0.0 { format!("{p:.2e}") } else { "<1e-300".to_string() }
 }
 
+/// A difference in standard errors for the console, to one decimal; one that rounds to zero is
+/// `0.0`, without the sign of a small negative difference.
+fn standard_errors_text(se: f64) -> String {
+    let text = format!("{se:.1}");
+    if text == "-0.0" { "0.0".to_string() } else { text }
+}
+
 /// A number of `models.csv` to `digits` significant digits, and a zero as `0`: six for an
 /// energy (a closed-form model's bins are accurate to 0.05 of the measured standard error, a
 /// Monte Carlo model's to its own), three for a standard error (an error bar).
@@ -926,7 +933,7 @@ fn report(
             let channel = if rgb { channel_name(rgb, c.lobe.3) } else { "-" };
             let _ = writeln!(
                 out,
-                "  {:>5} {order:>5} {:>4} {channel:>3} {:>10.1} {:>6} {:>10} {:>8.4} {:>8.4} {:>8.1} SE{}",
+                "  {:>5} {order:>5} {:>4} {channel:>3} {:>10.1} {:>6} {:>10} {:>8.4} {:>8.4} {:>8} SE{}",
                 c.lobe.0,
                 c.lobe.2,
                 c.test.statistic,
@@ -934,7 +941,7 @@ fn report(
                 p_value_text(c.test.p_value),
                 c.rel_l1,
                 c.rel_l2,
-                c.albedo_diff_se(),
+                standard_errors_text(c.albedo_diff_se()),
                 if c.test.p_value < level { "  rejected" } else { "" }
             );
         }
@@ -978,6 +985,31 @@ mod tests {
         assert_eq!(p_value_text(0.0), "<1e-300");
         assert_eq!(p_value_text(5.25e-110), "5.25e-110");
         assert_eq!(p_value_text(0.5), "5.00e-1");
+    }
+
+    /// A comparison of lobe (case 0, order 1, R, channel 0) with `model`: p-value `p`, the
+    /// measured albedo `measured` and the model's 0.5, both with standard error 0.1.
+    fn comparison(model: Model, p: f64, measured: f64) -> LobeComparison {
+        LobeComparison {
+            lobe: (0, 1, "R".to_string(), 0),
+            model,
+            test: ChiSquare { statistic: 1.0, dof: 1, p_value: p, cells: Vec::new() },
+            rel_l1: 0.0,
+            rel_l2: 0.0,
+            albedo_measured: Value { energy: measured, stderr: 0.1 },
+            albedo_model: Value { energy: 0.5, stderr: 0.1 },
+        }
+    }
+
+    #[test]
+    fn an_albedo_difference_that_rounds_to_zero_is_printed_without_a_sign() {
+        // Measured minus model is -0.004 in units of sqrt(0.1^2 + 0.1^2): -0.0 to one decimal.
+        let comparisons = [comparison(Model::Single, 0.5, 0.5 - 0.004 * 0.02_f64.sqrt())];
+        let verdicts = [Verdict { model: Model::Single, lobes: 1, rejected: 0, skipped: None }];
+        let text = report(&comparisons, &verdicts, &[], 0.01, false, None);
+        let row = text.lines().find(|l| l.trim_start().starts_with("0 ")).expect(&text);
+        assert!(row.ends_with(" 0.0 SE") && !text.contains("-0.0"), "{text}");
+        assert_eq!((standard_errors_text(-0.06), standard_errors_text(-0.0)), ("-0.1".into(), "0.0".into()));
     }
 
     #[test]
