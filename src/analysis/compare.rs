@@ -889,7 +889,15 @@ fn compare_table(
     Ok(w.into_inner()?)
 }
 
-/// The report: per model its family, level, rejections and worst lobes, then the verdict.
+/// What the columns of the worst-lobes table mean (docs/compare.md), printed after the first.
+const WORST_LOBES_LEGEND: [&str; 3] = [
+    "ch: channel (- in a one-channel run); rel L1, rel L2: the lobe's difference from the model in the",
+    "L1 and L2 norms, over the model's norm; albedo diff: measured minus model albedo, in units of",
+    "sqrt(SE_measured^2 + SE_model^2) (positive: the walk measured more light than the model gives)",
+];
+
+/// The report: per model its family, level, rejections and worst lobes (the first table with
+/// [`WORST_LOBES_LEGEND`] under it), then the verdict.
 fn report(
     comparisons: &[LobeComparison],
     verdicts: &[Verdict],
@@ -899,6 +907,7 @@ fn report(
     folded: Option<usize>,
 ) -> String {
     let mut out = String::new();
+    let mut legend = Some(WORST_LOBES_LEGEND);
     for v in verdicts {
         let kind = if is_exact_oracle(v.model) { "exact oracle" } else { "approximation" };
         if let Some(reason) = &v.skipped {
@@ -944,6 +953,9 @@ fn report(
                 standard_errors_text(c.albedo_diff_se()),
                 if c.test.p_value < level { "  rejected" } else { "" }
             );
+        }
+        for line in legend.take().into_iter().flatten() {
+            let _ = writeln!(out, "  {line}");
         }
     }
     if folded == Some(1) {
@@ -1010,6 +1022,21 @@ mod tests {
         let row = text.lines().find(|l| l.trim_start().starts_with("0 ")).expect(&text);
         assert!(row.ends_with(" 0.0 SE") && !text.contains("-0.0"), "{text}");
         assert_eq!((standard_errors_text(-0.06), standard_errors_text(-0.0)), ("-0.1".into(), "0.0".into()));
+    }
+
+    #[test]
+    fn the_worst_lobes_columns_are_explained_once_after_the_first_table() {
+        let comparisons = [comparison(Model::Single, 0.5, 0.6), comparison(Model::HeitzNee, 0.5, 0.6)];
+        let verdicts =
+            [Model::Single, Model::HeitzNee].map(|model| Verdict { model, lobes: 1, rejected: 0, skipped: None });
+        let text = report(&comparisons, &verdicts, &[], 0.01, false, None);
+        let lines: Vec<&str> = text.lines().collect();
+        // The line after the first table's row starts the legend; the second table has none.
+        let row = lines.iter().position(|l| l.trim_start().starts_with("0 ")).expect(&text);
+        assert!(lines[row + 1].starts_with("  ch: channel") && lines[row + 3].starts_with("  sqrt("), "{text}");
+        for term in ["ch: channel (- in a one-channel run)", "rel L1, rel L2:", "albedo diff: measured minus model"] {
+            assert_eq!(text.matches(term).count(), 1, "{term}: {text}");
+        }
     }
 
     #[test]
