@@ -70,11 +70,22 @@ pub struct CompareOptions {
     /// A table of `E` and `E_avg` with F = 1 that the compensation models read in place of the
     /// exact functions (`--albedo-table`, [`AlbedoTable`]).
     pub albedo_table: Option<PathBuf>,
+    /// Whether `models` is the default list, not one the user named: a model of it that applies
+    /// to no case of the run is then only named in one line of the report, with no section.
+    pub default_models: bool,
 }
 
 impl CompareOptions {
     pub fn new(models: Vec<Model>, paths: Option<u64>, threads: Option<usize>) -> Self {
-        Self { models, paths, threads, family_level: DEFAULT_FAMILY_LEVEL, external: None, albedo_table: None }
+        Self {
+            models,
+            paths,
+            threads,
+            family_level: DEFAULT_FAMILY_LEVEL,
+            external: None,
+            albedo_table: None,
+            default_models: false,
+        }
     }
 
     fn validate(&self) -> Result<()> {
@@ -736,7 +747,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
     let compare_csv = compare_table(&comparisons, &run, &verdicts, options.family_level, rgb, folded)?;
     let models_csv = models_table(&run, &predicted, rgb, folded)?;
     write_atomically(run_dir, &[("models.csv", models_csv), ("compare.csv", compare_csv)])?;
-    let report = report(&comparisons, &verdicts, &notes, options.family_level, rgb, folded);
+    let report = report(&comparisons, &verdicts, &notes, options.family_level, rgb, folded, options.default_models);
     Ok(Outcome { report, verdicts })
 }
 
@@ -897,7 +908,9 @@ const WORST_LOBES_LEGEND: [&str; 3] = [
 ];
 
 /// The report: per model its family, level, rejections and worst lobes (the first table with
-/// [`WORST_LOBES_LEGEND`] under it), then the verdict.
+/// [`WORST_LOBES_LEGEND`] under it), then the verdict. A model that applies to no case of the
+/// run says so in its section when the user named it; models of the default list
+/// (`default_models`) that apply to no case share one line instead.
 fn report(
     comparisons: &[LobeComparison],
     verdicts: &[Verdict],
@@ -905,13 +918,19 @@ fn report(
     family_level: f64,
     rgb: bool,
     folded: Option<usize>,
+    default_models: bool,
 ) -> String {
     let mut out = String::new();
     let mut legend = Some(WORST_LOBES_LEGEND);
+    let mut not_applicable: Vec<&str> = Vec::new();
     for v in verdicts {
         let kind = if is_exact_oracle(v.model) { "exact oracle" } else { "approximation" };
         if let Some(reason) = &v.skipped {
             let _ = writeln!(out, "{} ({kind}): {reason}", v.model.name());
+            continue;
+        }
+        if v.lobes == 0 && default_models {
+            not_applicable.push(v.model.name());
             continue;
         }
         if v.lobes == 0 {
@@ -957,6 +976,9 @@ fn report(
         for line in legend.take().into_iter().flatten() {
             let _ = writeln!(out, "  {line}");
         }
+    }
+    if !not_applicable.is_empty() {
+        let _ = writeln!(out, "not applicable to any case of this run: {}", not_applicable.join(", "));
     }
     if folded == Some(1) {
         let _ = writeln!(out, "(max_order = 1: the \"1+\" slot is the all-orders lobe, tested once as order 0)");
@@ -1018,7 +1040,7 @@ mod tests {
         // Measured minus model is -0.004 in units of sqrt(0.1^2 + 0.1^2): -0.0 to one decimal.
         let comparisons = [comparison(Model::Single, 0.5, 0.5 - 0.004 * 0.02_f64.sqrt())];
         let verdicts = [Verdict { model: Model::Single, lobes: 1, rejected: 0, skipped: None }];
-        let text = report(&comparisons, &verdicts, &[], 0.01, false, None);
+        let text = report(&comparisons, &verdicts, &[], 0.01, false, None, false);
         let row = text.lines().find(|l| l.trim_start().starts_with("0 ")).expect(&text);
         assert!(row.ends_with(" 0.0 SE") && !text.contains("-0.0"), "{text}");
         assert_eq!((standard_errors_text(-0.06), standard_errors_text(-0.0)), ("-0.1".into(), "0.0".into()));
@@ -1029,7 +1051,7 @@ mod tests {
         let comparisons = [comparison(Model::Single, 0.5, 0.6), comparison(Model::HeitzNee, 0.5, 0.6)];
         let verdicts =
             [Model::Single, Model::HeitzNee].map(|model| Verdict { model, lobes: 1, rejected: 0, skipped: None });
-        let text = report(&comparisons, &verdicts, &[], 0.01, false, None);
+        let text = report(&comparisons, &verdicts, &[], 0.01, false, None, false);
         let lines: Vec<&str> = text.lines().collect();
         // The line after the first table's row starts the legend; the second table has none.
         let row = lines.iter().position(|l| l.trim_start().starts_with("0 ")).expect(&text);
