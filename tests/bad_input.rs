@@ -44,6 +44,10 @@ fn every_bad_config_names_its_field_value_and_what_is_allowed() {
             ["`material.k` is missing: fresnel = \"exact\" needs the extinction coefficient, >= 0", "[r, g, b]"],
         ),
         (
+            with("theta_deg = 30", "theta_deg = 30\ntheta_rad = 0.5"),
+            ["`incident.theta_deg` and `incident.theta_rad` are both given: give one of them", ""],
+        ),
+        (
             with("theta_deg = 30", "phi_deg = 30"),
             ["`incident.theta_deg` is missing: a polar angle in [0, 90)", "`theta_rad`"],
         ),

@@ -593,6 +593,9 @@ pub enum ConfigError {
     /// A required table or key that is absent; `place` is empty or says where it belongs.
     #[error("`{field}` is missing{place}: {allowed}")]
     Missing { field: String, place: String, allowed: String },
+    /// Two keys that say the same thing in different ways, of which one at most may be given.
+    #[error("`{first}` and `{second}` are both given: give one of them")]
+    Exclusive { first: String, second: String },
 }
 
 impl ConfigError {
@@ -704,11 +707,8 @@ impl Config {
         }
         let i = &self.incident;
         if i.theta_deg.is_some() && i.theta_rad.is_some() {
-            return Err(invalid(
-                "incident.theta_rad",
-                "given with incident.theta_deg",
-                "one of theta_deg or theta_rad",
-            ));
+            let [first, second] = ["incident.theta_deg", "incident.theta_rad"].map(String::from);
+            return Err(ConfigError::Exclusive { first, second });
         }
         let (field, values, limit) = match (&i.theta_deg, &i.theta_rad) {
             (Some(d), _) => ("incident.theta_deg", d.values(), 90.0),
