@@ -572,6 +572,10 @@ pub const MAX_PATHS: u64 = 1_000_000_000_000_000;
 /// docs/reliability.md).
 pub const MAX_ALPHA: f64 = 1e4;
 
+/// The tables of a run config (`smithwalk run`), every top-level key but `paths` and `seed`; a
+/// table config (`smithwalk lut`) has none of them.
+pub const RUN_TABLES: [&str; 7] = ["surface", "material", "incident", "detector", "energy", "precision", "compare"];
+
 /// The most cases a sweep may expand to.
 pub const MAX_CASES: u64 = 1_000_000;
 
@@ -623,6 +627,19 @@ impl ConfigError {
     }
 }
 
+/// Refuses a table config (`smithwalk lut`, which has a `table` key) read as a run config.
+fn not_a_table_config(document: &toml::Table) -> Result<(), ConfigError> {
+    match document.get("table") {
+        Some(table) => Err(invalid(
+            "table",
+            shorten(&table.to_string(), VALUE_CHARS),
+            "this is a table config for `smithwalk lut`; `smithwalk run` reads a run config, with the tables \
+             [surface], [material] and [incident] (configs/quickstart.toml, README.md)",
+        )),
+        None => Ok(()),
+    }
+}
+
 pub(crate) fn invalid(field: impl Into<String>, value: impl fmt::Display, allowed: impl Into<String>) -> ConfigError {
     ConfigError::Invalid { field: field.into(), value: value.to_string(), allowed: allowed.into() }
 }
@@ -642,6 +659,9 @@ impl Config {
 
     /// Parses and validates TOML text; errors name it `<text>`.
     pub fn parse(text: &str) -> Result<Self, ConfigError> {
+        if let Ok(document) = text.parse::<toml::Table>() {
+            not_a_table_config(&document).map_err(|e| e.in_source("<text>"))?;
+        }
         let config: Config = parse_toml(text)?;
         config.validate().map_err(|e| e.in_source("<text>"))?;
         Ok(config)
@@ -651,6 +671,7 @@ impl Config {
     /// the checks of a file; errors name it `<dict>` and no lines, which a dict does not have.
     pub fn from_table(table: &toml::Table) -> Result<Self, ConfigError> {
         let in_dict = |e: ConfigError| e.in_source("<dict>");
+        not_a_table_config(table).map_err(in_dict)?;
         let text = toml::to_string(table)
             .map_err(|e| in_dict(ConfigError::Parse { path: String::new(), message: e.to_string() }))?;
         let config: Config = parse_toml_with(&text, false).map_err(in_dict)?;
@@ -1035,5 +1056,26 @@ fn fresnel_name(f: FresnelKind) -> &'static str {
         FresnelKind::None => "none",
         FresnelKind::Schlick => "schlick",
         FresnelKind::Exact => "exact",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_run_tables_are_the_top_level_keys_of_a_run_config_but_paths_and_seed() {
+        let config = Config::parse(
+            "paths = 1000\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 0\n\
+             [precision]\ntarget_stderr = 0.01\n[compare]\nmodels = [\"single\"]\n",
+        )
+        .unwrap();
+        let document: toml::Table = toml::to_string(&config).unwrap().parse().unwrap();
+        let mut keys: Vec<&str> =
+            document.keys().map(String::as_str).filter(|k| !["paths", "seed"].contains(k)).collect();
+        let mut tables = RUN_TABLES.to_vec();
+        keys.sort_unstable();
+        tables.sort_unstable();
+        assert_eq!(keys, tables);
     }
 }
