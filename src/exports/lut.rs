@@ -23,7 +23,7 @@ use crate::engine::{RunOptions, Simulation};
 use crate::io::output::name;
 use crate::setup::config::{
     Alpha, Channels, Config, ConfigError, DetectorConfig, EnergyConfig, IncidentConfig, IncidentSide, MaterialConfig,
-    NdfKind, OneOrMany, PrecisionConfig, RUN_TABLES, SurfaceConfig, invalid,
+    NdfKind, OneOrMany, PrecisionConfig, RUN_TABLES, SurfaceConfig, invalid, parse_toml,
 };
 
 /// Which facet material a table is for.
@@ -124,12 +124,13 @@ impl LutConfig {
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
         let text = std::fs::read_to_string(path)
             .map_err(|cause| ConfigError::Read { path: path.display().to_string(), cause })?;
-        let parse_error = |message: String| ConfigError::Parse { path: path.display().to_string(), message };
+        let in_file = |e: ConfigError| e.in_source(&path.display().to_string());
         if let Ok(document) = text.parse::<toml::Table>() {
-            not_a_run_config(&document).map_err(parse_error)?;
+            not_a_run_config(&document)
+                .map_err(|message| in_file(ConfigError::Parse { path: String::new(), message }))?;
         }
-        let config: LutConfig = toml::from_str(&text).map_err(|e| parse_error(e.to_string()))?;
-        config.validate().map_err(|e| e.in_source(&path.display().to_string()))?;
+        let config: LutConfig = parse_toml(&text).map_err(in_file)?;
+        config.validate().map_err(in_file)?;
         Ok(config)
     }
 

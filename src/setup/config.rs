@@ -843,7 +843,7 @@ fn parse_toml_with<T: serde::de::DeserializeOwned>(text: &str, lines: bool) -> R
             }
             // At the top level the span is the whole text: no line says where the key belongs.
             (None, Some(k)) if field == "." => {
-                let field = if k == "paths" { k.to_string() } else { format!("[{k}]") };
+                let field = if RUN_TABLES.contains(&k) { format!("[{k}]") } else { k.to_string() };
                 let allowed = required(k).unwrap_or(allowed);
                 parse(ConfigError::Missing { field, place: String::new(), allowed }.to_string())
             }
@@ -900,6 +900,7 @@ fn required(key: &str) -> Option<String> {
     let kinds = "\"conductor\", \"dielectric\", \"diffuse\" or \"hammon\"";
     Some(match key {
         "paths" => "photons per case, from 2 to 10^15".into(),
+        "table" => "the table config's facet, \"conductor\", \"dielectric\" or \"hammon\"".into(),
         "surface" => "a table with `alpha`, the roughness".into(),
         "material" => format!("a table with `kind` = {kinds}, or several `[[material]]` tables"),
         "incident" => "a table with `theta_deg` or `theta_rad`, the incident polar angles".into(),
