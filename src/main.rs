@@ -7,7 +7,8 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
-use clap::{Parser, Subcommand};
+use clap::parser::ValueSource;
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use smithwalk::atomic::{lock_dir, prepare_dir};
 use smithwalk::engine::checkpoint::{self, Checkpointer};
 use smithwalk::engine::run::{Estimator, Shard};
@@ -587,7 +588,11 @@ fn warn_losses(sim: &Simulation) {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let matches = Cli::command().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    // `compare` without `--models` compares with the default list.
+    let default_models =
+        matches.subcommand_matches("compare").and_then(|m| m.value_source("models")) == Some(ValueSource::DefaultValue);
     let result = match cli.command {
         Command::Run { config, paths, seed, threads, out, shard, resume, checkpoint_seconds } => {
             run(RunArgs { config, paths, seed, threads, out, shard, resume, checkpoint_seconds })
@@ -598,6 +603,7 @@ fn main() -> ExitCode {
                 family_level: level,
                 external,
                 albedo_table,
+                default_models,
                 ..smithwalk::analysis::compare::CompareOptions::new(models, paths, threads)
             };
             match smithwalk::analysis::compare::compare_with(&run_dir, &options) {

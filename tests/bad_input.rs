@@ -1,7 +1,8 @@
 //! Every bad config gets one line naming the field, the value as written and what is allowed
 //! (never serde's "did not match any variant of untagged enum"); long inputs are quoted
 //! shortened; configs beyond the documented limits (photons, roughness, threads, memory) are
-//! refused before any work, with nothing written.
+//! refused before any work, with nothing written; a run config given to `smithwalk lut`, or a
+//! table config to `smithwalk run`, says which command reads it.
 
 use std::process::Command;
 
@@ -42,6 +43,10 @@ fn every_bad_config_names_its_field_value_and_what_is_allowed() {
         (
             with("\"conductor\"", "\"conductor\"\nfresnel = \"exact\"\neta = 0.2"),
             ["`material.k` is missing: fresnel = \"exact\" needs the extinction coefficient, >= 0", "[r, g, b]"],
+        ),
+        (
+            with("theta_deg = 30", "theta_deg = 30\ntheta_rad = 0.5"),
+            ["`incident.theta_deg` and `incident.theta_rad` are both given: give one of them", ""],
         ),
         (
             with("theta_deg = 30", "phi_deg = 30"),
@@ -138,20 +143,54 @@ fn a_50_mb_line_is_quoted_shortened() {
     }
 }
 
-/// Runs the binary on `config` (written to a temporary file) with `args`; returns the exit
-/// code and stderr, and checks that the output directory was not created.
+/// Runs `smithwalk run` on `config` (written to a temporary file) with `args`; returns the
+/// exit code and stderr, and checks that the output directory was not created.
 fn run(config: &str, args: &[&str]) -> (Option<i32>, String) {
+    run_command("run", config, args)
+}
+
+/// [`run`] with the command `command` (`run` or `lut`, which take a config and `--out`).
+fn run_command(command: &str, config: &str, args: &[&str]) -> (Option<i32>, String) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("c.toml");
     std::fs::write(&path, config).unwrap();
     let out_dir = dir.path().join("out");
     let out = Command::new(env!("CARGO_BIN_EXE_smithwalk"))
-        .args(["run", path.to_str().unwrap(), "--out", out_dir.to_str().unwrap()])
+        .args([command, path.to_str().unwrap(), "--out", out_dir.to_str().unwrap()])
         .args(args)
         .output()
         .unwrap();
-    assert!(!out_dir.exists(), "{args:?}: an output directory was made");
+    assert!(!out_dir.exists(), "{command} {args:?}: an output directory was made");
     (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+#[test]
+fn a_config_given_to_the_other_command_says_which_command_reads_it() {
+    let config =
+        |name: &str| std::fs::read_to_string(format!("{}/configs/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap();
+    let (code, e) = run_command("lut", &config("quickstart.toml"), &[]);
+    assert_eq!(code, Some(1), "{e}");
+    for part in [
+        "c.toml is not valid: ",
+        "`[surface]`, `[material]`, `[incident]`, `[detector]`",
+        "run config for `smithwalk run`",
+        "configs/lut-*.toml",
+        "docs/exports.md",
+    ] {
+        assert!(e.contains(part), "{e:?} lacks {part:?}");
+    }
+    assert_eq!(e.lines().count(), 1, "{e}");
+    let (code, e) = run_command("run", &config("lut-conductor.toml"), &[]);
+    assert_eq!(code, Some(1), "{e}");
+    for part in [
+        "c.toml is not valid: ",
+        "`table` = \"conductor\"",
+        "table config for `smithwalk lut`",
+        "configs/quickstart.toml",
+    ] {
+        assert!(e.contains(part), "{e:?} lacks {part:?}");
+    }
+    assert_eq!(e.lines().count(), 1, "{e}");
 }
 
 #[test]

@@ -11,6 +11,8 @@
 //!   `single` at family level 0.01 and `--fail-on-reject` exits with status 3; the true
 //!   measurement is not rejected and exits 0.
 //! * Bad options are refused with one line naming the option, and nothing is written.
+//! * A model that applies to no case says so when asked for with `--models`; the default list's
+//!   such models (here `hammon-fit`) are named together in one line, with no section.
 //! * Every model terminates: `single` at alpha 1e-4 and 1e-3 and theta 0, 30 and 89 deg, on
 //!   runs of 20 000 photons, accepts the walk's order-1 lobe at family level 0.01 over the six
 //!   lobes (the quadrature with a tolerance of 0.05 of each bin's standard error and a bound on
@@ -78,10 +80,24 @@ fn a_folded_run_gives_no_rejection_that_an_unfolded_one_does_not() {
             assert_eq!(r["folded"] == "true", r["order"] == "4", "{table}: {r:?}");
         }
     }
-    // The exact oracles reject nothing in either run.
+    // The exact oracles reject nothing in either run; hammon-fit, a default model that applies
+    // to none of these cases (no Hammon facets), is named in one line, with no section.
     for (_, report) in &runs {
         assert!(report.contains("verdict: no exact oracle rejects the run"), "{report}");
+        assert!(report.contains("\nnot applicable to any case of this run: hammon-fit\n"), "{report}");
+        assert!(!report.contains("hammon-fit (approximation)"), "{report}");
     }
+}
+
+#[test]
+fn a_model_asked_for_that_applies_to_no_case_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run(dir.path(), "run", &format!("paths = 1000\n{CASES}"));
+    let result = smithwalk(&["compare", &out, "--models", "single,hammon-fit"]);
+    let report = String::from_utf8_lossy(&result.stdout);
+    assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
+    assert!(report.contains("\nhammon-fit (approximation): applies to no case of this run\n"), "{report}");
+    assert!(!report.contains("not applicable"), "{report}");
 }
 
 #[test]

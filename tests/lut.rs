@@ -184,6 +184,24 @@ fn bad_table_configs_name_the_field() {
 }
 
 #[test]
+fn a_table_config_that_does_not_read_gets_one_line_naming_the_key() {
+    let cases = [
+        ("table = \"conductor\"\nmu_nodes = 3\npaths = 10\n", "`mu_nodes` is not a known key (line 2)"),
+        ("table = \"conductor\"\nmu = \"x\"\npaths = 10\n", "`mu` = \"x\" is not allowed (line 2)"),
+        ("table = \"metal\"\npaths = 10\n", "`table` = \"metal\" is not allowed (line 1)"),
+        ("paths = 10\n", "`table` is missing: the table config's facet, \"conductor\", \"dielectric\" or \"hammon\""),
+    ];
+    for (toml, expected) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.toml");
+        std::fs::write(&path, toml).unwrap();
+        let err = LutConfig::load(&path).expect_err(toml).to_string();
+        assert!(err.starts_with(&format!("config {} is not valid: ", path.display())), "{toml}: {err}");
+        assert!(err.contains(expected) && !err.contains('\n'), "{toml}: {err}");
+    }
+}
+
+#[test]
 fn a_bad_photon_count_on_the_command_line_is_named_as_typed() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("t.toml");

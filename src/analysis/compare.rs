@@ -70,11 +70,22 @@ pub struct CompareOptions {
     /// A table of `E` and `E_avg` with F = 1 that the compensation models read in place of the
     /// exact functions (`--albedo-table`, [`AlbedoTable`]).
     pub albedo_table: Option<PathBuf>,
+    /// Whether `models` is the default list, not one the user named: a model of it that applies
+    /// to no case of the run is then only named in one line of the report, with no section.
+    pub default_models: bool,
 }
 
 impl CompareOptions {
     pub fn new(models: Vec<Model>, paths: Option<u64>, threads: Option<usize>) -> Self {
-        Self { models, paths, threads, family_level: DEFAULT_FAMILY_LEVEL, external: None, albedo_table: None }
+        Self {
+            models,
+            paths,
+            threads,
+            family_level: DEFAULT_FAMILY_LEVEL,
+            external: None,
+            albedo_table: None,
+            default_models: false,
+        }
     }
 
     fn validate(&self) -> Result<()> {
@@ -572,6 +583,13 @@ fn p_value_text(p: f64) -> String {
     if p > 0.0 { format!("{p:.2e}") } else { "<1e-300".to_string() }
 }
 
+/// A difference in standard errors for the console, to one decimal; one that rounds to zero is
+/// `0.0`, without the sign of a small negative difference.
+fn standard_errors_text(se: f64) -> String {
+    let text = format!("{se:.1}");
+    if text == "-0.0" { "0.0".to_string() } else { text }
+}
+
 /// A number of `models.csv` to `digits` significant digits, and a zero as `0`: six for an
 /// energy (a closed-form model's bins are accurate to 0.05 of the measured standard error, a
 /// Monte Carlo model's to its own), three for a standard error (an error bar).
@@ -729,7 +747,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
     let compare_csv = compare_table(&comparisons, &run, &verdicts, options.family_level, rgb, folded)?;
     let models_csv = models_table(&run, &predicted, rgb, folded)?;
     write_atomically(run_dir, &[("models.csv", models_csv), ("compare.csv", compare_csv)])?;
-    let report = report(&comparisons, &verdicts, &notes, options.family_level, rgb, folded);
+    let report = report(&comparisons, &verdicts, &notes, options.family_level, rgb, folded, options.default_models);
     Ok(Outcome { report, verdicts })
 }
 
@@ -882,7 +900,17 @@ fn compare_table(
     Ok(w.into_inner()?)
 }
 
-/// The report: per model its family, level, rejections and worst lobes, then the verdict.
+/// What the columns of the worst-lobes table mean (docs/compare.md), printed after the first.
+const WORST_LOBES_LEGEND: [&str; 3] = [
+    "ch: channel (- in a one-channel run); rel L1, rel L2: the lobe's difference from the model in the",
+    "L1 and L2 norms, over the model's norm; albedo diff: measured minus model albedo, in units of",
+    "sqrt(SE_measured^2 + SE_model^2) (positive: the walk measured more light than the model gives)",
+];
+
+/// The report: per model its family, level, rejections and worst lobes (the first table with
+/// [`WORST_LOBES_LEGEND`] under it), then the verdict. A model that applies to no case of the
+/// run says so in its section when the user named it; models of the default list
+/// (`default_models`) that apply to no case share one line instead.
 fn report(
     comparisons: &[LobeComparison],
     verdicts: &[Verdict],
@@ -890,12 +918,19 @@ fn report(
     family_level: f64,
     rgb: bool,
     folded: Option<usize>,
+    default_models: bool,
 ) -> String {
     let mut out = String::new();
+    let mut legend = Some(WORST_LOBES_LEGEND);
+    let mut not_applicable: Vec<&str> = Vec::new();
     for v in verdicts {
         let kind = if is_exact_oracle(v.model) { "exact oracle" } else { "approximation" };
         if let Some(reason) = &v.skipped {
             let _ = writeln!(out, "{} ({kind}): {reason}", v.model.name());
+            continue;
+        }
+        if v.lobes == 0 && default_models {
+            not_applicable.push(v.model.name());
             continue;
         }
         if v.lobes == 0 {
@@ -926,7 +961,7 @@ fn report(
             let channel = if rgb { channel_name(rgb, c.lobe.3) } else { "-" };
             let _ = writeln!(
                 out,
-                "  {:>5} {order:>5} {:>4} {channel:>3} {:>10.1} {:>6} {:>10} {:>8.4} {:>8.4} {:>8.1} SE{}",
+                "  {:>5} {order:>5} {:>4} {channel:>3} {:>10.1} {:>6} {:>10} {:>8.4} {:>8.4} {:>8} SE{}",
                 c.lobe.0,
                 c.lobe.2,
                 c.test.statistic,
@@ -934,10 +969,16 @@ fn report(
                 p_value_text(c.test.p_value),
                 c.rel_l1,
                 c.rel_l2,
-                c.albedo_diff_se(),
+                standard_errors_text(c.albedo_diff_se()),
                 if c.test.p_value < level { "  rejected" } else { "" }
             );
         }
+        for line in legend.take().into_iter().flatten() {
+            let _ = writeln!(out, "  {line}");
+        }
+    }
+    if !not_applicable.is_empty() {
+        let _ = writeln!(out, "not applicable to any case of this run: {}", not_applicable.join(", "));
     }
     if folded == Some(1) {
         let _ = writeln!(out, "(max_order = 1: the \"1+\" slot is the all-orders lobe, tested once as order 0)");
@@ -978,6 +1019,46 @@ mod tests {
         assert_eq!(p_value_text(0.0), "<1e-300");
         assert_eq!(p_value_text(5.25e-110), "5.25e-110");
         assert_eq!(p_value_text(0.5), "5.00e-1");
+    }
+
+    /// A comparison of lobe (case 0, order 1, R, channel 0) with `model`: p-value `p`, the
+    /// measured albedo `measured` and the model's 0.5, both with standard error 0.1.
+    fn comparison(model: Model, p: f64, measured: f64) -> LobeComparison {
+        LobeComparison {
+            lobe: (0, 1, "R".to_string(), 0),
+            model,
+            test: ChiSquare { statistic: 1.0, dof: 1, p_value: p, cells: Vec::new() },
+            rel_l1: 0.0,
+            rel_l2: 0.0,
+            albedo_measured: Value { energy: measured, stderr: 0.1 },
+            albedo_model: Value { energy: 0.5, stderr: 0.1 },
+        }
+    }
+
+    #[test]
+    fn an_albedo_difference_that_rounds_to_zero_is_printed_without_a_sign() {
+        // Measured minus model is -0.004 in units of sqrt(0.1^2 + 0.1^2): -0.0 to one decimal.
+        let comparisons = [comparison(Model::Single, 0.5, 0.5 - 0.004 * 0.02_f64.sqrt())];
+        let verdicts = [Verdict { model: Model::Single, lobes: 1, rejected: 0, skipped: None }];
+        let text = report(&comparisons, &verdicts, &[], 0.01, false, None, false);
+        let row = text.lines().find(|l| l.trim_start().starts_with("0 ")).expect(&text);
+        assert!(row.ends_with(" 0.0 SE") && !text.contains("-0.0"), "{text}");
+        assert_eq!((standard_errors_text(-0.06), standard_errors_text(-0.0)), ("-0.1".into(), "0.0".into()));
+    }
+
+    #[test]
+    fn the_worst_lobes_columns_are_explained_once_after_the_first_table() {
+        let comparisons = [comparison(Model::Single, 0.5, 0.6), comparison(Model::HeitzNee, 0.5, 0.6)];
+        let verdicts =
+            [Model::Single, Model::HeitzNee].map(|model| Verdict { model, lobes: 1, rejected: 0, skipped: None });
+        let text = report(&comparisons, &verdicts, &[], 0.01, false, None, false);
+        let lines: Vec<&str> = text.lines().collect();
+        // The line after the first table's row starts the legend; the second table has none.
+        let row = lines.iter().position(|l| l.trim_start().starts_with("0 ")).expect(&text);
+        assert!(lines[row + 1].starts_with("  ch: channel") && lines[row + 3].starts_with("  sqrt("), "{text}");
+        for term in ["ch: channel (- in a one-channel run)", "rel L1, rel L2:", "albedo diff: measured minus model"] {
+            assert_eq!(text.matches(term).count(), 1, "{term}: {text}");
+        }
     }
 
     #[test]

@@ -23,7 +23,7 @@ use crate::engine::{RunOptions, Simulation};
 use crate::io::output::name;
 use crate::setup::config::{
     Alpha, Channels, Config, ConfigError, DetectorConfig, EnergyConfig, IncidentConfig, IncidentSide, MaterialConfig,
-    NdfKind, OneOrMany, PrecisionConfig, SurfaceConfig, invalid,
+    NdfKind, OneOrMany, PrecisionConfig, RUN_TABLES, SurfaceConfig, invalid, parse_toml,
 };
 
 /// Which facet material a table is for.
@@ -104,14 +104,33 @@ fn cell_centres(n: usize, [lo, hi]: [f64; 2]) -> Vec<f64> {
     (0..n).map(|i| lo + (i as f64 + 0.5) * (hi - lo) / n as f64).collect()
 }
 
+/// Refuses a run config (`smithwalk run`) read as a table config: the message names the run
+/// config's tables it has and where the table format is described.
+fn not_a_run_config(document: &toml::Table) -> Result<(), String> {
+    let tables: Vec<String> =
+        RUN_TABLES.iter().filter(|t| document.contains_key(**t)).map(|t| format!("`[{t}]`")).collect();
+    if tables.is_empty() {
+        return Ok(());
+    }
+    Err(format!(
+        "this looks like a run config for `smithwalk run` (it has {}); `smithwalk lut` reads a table config, \
+         with `table` = \"conductor\", \"dielectric\" or \"hammon\" and its grid (configs/lut-*.toml, docs/exports.md)",
+        tables.join(", ")
+    ))
+}
+
 impl LutConfig {
     /// Reads, parses and validates a TOML table configuration.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
         let text = std::fs::read_to_string(path)
             .map_err(|cause| ConfigError::Read { path: path.display().to_string(), cause })?;
-        let config: LutConfig = toml::from_str(&text)
-            .map_err(|e| ConfigError::Parse { path: path.display().to_string(), message: e.to_string() })?;
-        config.validate().map_err(|e| e.in_source(&path.display().to_string()))?;
+        let in_file = |e: ConfigError| e.in_source(&path.display().to_string());
+        if let Ok(document) = text.parse::<toml::Table>() {
+            not_a_run_config(&document)
+                .map_err(|message| in_file(ConfigError::Parse { path: String::new(), message }))?;
+        }
+        let config: LutConfig = parse_toml(&text).map_err(in_file)?;
+        config.validate().map_err(in_file)?;
         Ok(config)
     }
 

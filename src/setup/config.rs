@@ -572,6 +572,10 @@ pub const MAX_PATHS: u64 = 1_000_000_000_000_000;
 /// docs/reliability.md).
 pub const MAX_ALPHA: f64 = 1e4;
 
+/// The tables of a run config (`smithwalk run`), every top-level key but `paths` and `seed`; a
+/// table config (`smithwalk lut`) has none of them.
+pub const RUN_TABLES: [&str; 7] = ["surface", "material", "incident", "detector", "energy", "precision", "compare"];
+
 /// The most cases a sweep may expand to.
 pub const MAX_CASES: u64 = 1_000_000;
 
@@ -593,6 +597,9 @@ pub enum ConfigError {
     /// A required table or key that is absent; `place` is empty or says where it belongs.
     #[error("`{field}` is missing{place}: {allowed}")]
     Missing { field: String, place: String, allowed: String },
+    /// Two keys that say the same thing in different ways, of which one at most may be given.
+    #[error("`{first}` and `{second}` are both given: give one of them")]
+    Exclusive { first: String, second: String },
 }
 
 impl ConfigError {
@@ -620,6 +627,19 @@ impl ConfigError {
     }
 }
 
+/// Refuses a table config (`smithwalk lut`, which has a `table` key) read as a run config.
+fn not_a_table_config(document: &toml::Table) -> Result<(), ConfigError> {
+    match document.get("table") {
+        Some(table) => Err(invalid(
+            "table",
+            shorten(&table.to_string(), VALUE_CHARS),
+            "this is a table config for `smithwalk lut`; `smithwalk run` reads a run config, with the tables \
+             [surface], [material] and [incident] (configs/quickstart.toml, README.md)",
+        )),
+        None => Ok(()),
+    }
+}
+
 pub(crate) fn invalid(field: impl Into<String>, value: impl fmt::Display, allowed: impl Into<String>) -> ConfigError {
     ConfigError::Invalid { field: field.into(), value: value.to_string(), allowed: allowed.into() }
 }
@@ -639,6 +659,9 @@ impl Config {
 
     /// Parses and validates TOML text; errors name it `<text>`.
     pub fn parse(text: &str) -> Result<Self, ConfigError> {
+        if let Ok(document) = text.parse::<toml::Table>() {
+            not_a_table_config(&document).map_err(|e| e.in_source("<text>"))?;
+        }
         let config: Config = parse_toml(text)?;
         config.validate().map_err(|e| e.in_source("<text>"))?;
         Ok(config)
@@ -648,6 +671,7 @@ impl Config {
     /// the checks of a file; errors name it `<dict>` and no lines, which a dict does not have.
     pub fn from_table(table: &toml::Table) -> Result<Self, ConfigError> {
         let in_dict = |e: ConfigError| e.in_source("<dict>");
+        not_a_table_config(table).map_err(in_dict)?;
         let text = toml::to_string(table)
             .map_err(|e| in_dict(ConfigError::Parse { path: String::new(), message: e.to_string() }))?;
         let config: Config = parse_toml_with(&text, false).map_err(in_dict)?;
@@ -704,11 +728,8 @@ impl Config {
         }
         let i = &self.incident;
         if i.theta_deg.is_some() && i.theta_rad.is_some() {
-            return Err(invalid(
-                "incident.theta_rad",
-                "given with incident.theta_deg",
-                "one of theta_deg or theta_rad",
-            ));
+            let [first, second] = ["incident.theta_deg", "incident.theta_rad"].map(String::from);
+            return Err(ConfigError::Exclusive { first, second });
         }
         let (field, values, limit) = match (&i.theta_deg, &i.theta_rad) {
             (Some(d), _) => ("incident.theta_deg", d.values(), 90.0),
@@ -822,7 +843,7 @@ fn parse_toml_with<T: serde::de::DeserializeOwned>(text: &str, lines: bool) -> R
             }
             // At the top level the span is the whole text: no line says where the key belongs.
             (None, Some(k)) if field == "." => {
-                let field = if k == "paths" { k.to_string() } else { format!("[{k}]") };
+                let field = if RUN_TABLES.contains(&k) { format!("[{k}]") } else { k.to_string() };
                 let allowed = required(k).unwrap_or(allowed);
                 parse(ConfigError::Missing { field, place: String::new(), allowed }.to_string())
             }
@@ -879,6 +900,7 @@ fn required(key: &str) -> Option<String> {
     let kinds = "\"conductor\", \"dielectric\", \"diffuse\" or \"hammon\"";
     Some(match key {
         "paths" => "photons per case, from 2 to 10^15".into(),
+        "table" => "the table config's facet, \"conductor\", \"dielectric\" or \"hammon\"".into(),
         "surface" => "a table with `alpha`, the roughness".into(),
         "material" => format!("a table with `kind` = {kinds}, or several `[[material]]` tables"),
         "incident" => "a table with `theta_deg` or `theta_rad`, the incident polar angles".into(),
@@ -1035,5 +1057,26 @@ fn fresnel_name(f: FresnelKind) -> &'static str {
         FresnelKind::None => "none",
         FresnelKind::Schlick => "schlick",
         FresnelKind::Exact => "exact",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_run_tables_are_the_top_level_keys_of_a_run_config_but_paths_and_seed() {
+        let config = Config::parse(
+            "paths = 1000\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 0\n\
+             [precision]\ntarget_stderr = 0.01\n[compare]\nmodels = [\"single\"]\n",
+        )
+        .unwrap();
+        let document: toml::Table = toml::to_string(&config).unwrap().parse().unwrap();
+        let mut keys: Vec<&str> =
+            document.keys().map(String::as_str).filter(|k| !["paths", "seed"].contains(k)).collect();
+        let mut tables = RUN_TABLES.to_vec();
+        keys.sort_unstable();
+        tables.sort_unstable();
+        assert_eq!(keys, tables);
     }
 }
