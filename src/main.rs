@@ -262,9 +262,11 @@ fn bench_precision(paths: u64, energy: &EnergyConfig) -> Result<()> {
         )?;
     let mut out = std::io::stdout().lock();
     let legend = format!(
-        "[energy] split = {}, threshold = {}. Per albedo (orders 1, 2, 3 and all; R, T): CPU seconds on \
-         1 thread to a 1% relative standard error, and in brackets the Heitz 2016 reference's time \
-         over it (its rate measured per case, docs/performance.md); `exact`: no variance on either \
+        "[energy] split = {}, threshold = {}. Per albedo (orders 1, 2, 3 and all; R, T): the CPU seconds \
+         on 1 thread that a 1% relative standard error needs, projected from this run's per-photon \
+         variance and rate, and in brackets the Heitz 2016 reference's projected time over it (its \
+         binomial variance at its rates per case, measured on the host of docs/performance.md, not \
+         here: on another or a loaded machine the ratios differ); `exact`: no variance on either \
          side; `-`: no light.",
         energy.split, energy.threshold
     );

@@ -579,7 +579,7 @@ fn cpu_seconds() -> f64 {
 
 /// A p-value for the console, to three digits; one too small for f64 (which a lobe far from its
 /// model gives) as the bound it is, not as `0.00e0`.
-fn p_value_text(p: f64) -> String {
+pub fn p_value_text(p: f64) -> String {
     if p > 0.0 { format!("{p:.2e}") } else { "<1e-300".to_string() }
 }
 
@@ -902,9 +902,9 @@ fn compare_table(
 
 /// What the columns of the worst-lobes table mean (docs/compare.md), printed after the first.
 const WORST_LOBES_LEGEND: [&str; 3] = [
-    "ch: channel (- in a one-channel run); rel L1, rel L2: the lobe's difference from the model in the",
-    "L1 and L2 norms, over the model's norm; albedo diff: measured minus model albedo, in units of",
-    "sqrt(SE_measured^2 + SE_model^2) (positive: the walk measured more light than the model gives)",
+    "order 0: all orders; ch: channel (- in a one-channel run); rel L1, rel L2: the lobe's difference",
+    "from the model in the L1 and L2 norms, over the model's norm; albedo diff: measured minus model",
+    "albedo in units of sqrt(SE_measured^2 + SE_model^2) (positive: the walk measured more light)",
 ];
 
 /// The report: per model its family, level, rejections and worst lobes (the first table with
@@ -1055,8 +1055,16 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         // The line after the first table's row starts the legend; the second table has none.
         let row = lines.iter().position(|l| l.trim_start().starts_with("0 ")).expect(&text);
-        assert!(lines[row + 1].starts_with("  ch: channel") && lines[row + 3].starts_with("  sqrt("), "{text}");
-        for term in ["ch: channel (- in a one-channel run)", "rel L1, rel L2:", "albedo diff: measured minus model"] {
+        assert!(
+            lines[row + 1].starts_with("  order 0: all orders") && lines[row + 3].starts_with("  albedo in"),
+            "{text}"
+        );
+        for term in [
+            "order 0: all orders",
+            "ch: channel (- in a one-channel run)",
+            "rel L1, rel L2:",
+            "albedo diff: measured minus model",
+        ] {
             assert_eq!(text.matches(term).count(), 1, "{term}: {text}");
         }
     }

@@ -152,9 +152,6 @@ impl HeatFigure<'_> {
         let (caption, area) = area.split_vertically(CAPTION_HEIGHT);
         let (w, _) = caption.dim_in_pixel();
         let mut label = row_label(self.run, row);
-        if log {
-            label += ", log scale";
-        }
         match above {
             0 => {}
             1 => label += " (1 bin above scale)",
@@ -210,7 +207,7 @@ impl HeatFigure<'_> {
         let circle: Vec<(f64, f64)> =
             (0..=180).map(|k| (k as f64 * 2.0).to_radians()).map(|p| (p.cos(), p.sin())).collect();
         chart.draw_series(std::iter::once(PathElement::new(circle, BLACK.stroke_width(1)))).map_err(draw_err)?;
-        if self.hemisphere == "R" && self.case.theta_i_deg > 0.0 {
+        if self.hemisphere == "R" {
             // The mirror direction, theta_o = theta_i at phi_o = 180 deg, as a ring: a marker that
             // covered it would hide the peak it marks (at grazing incidence, at the rim).
             let mirror = (-self.case.theta_i_deg.to_radians().sin(), 0.0);
@@ -256,8 +253,13 @@ impl HeatFigure<'_> {
     }
 }
 
-/// A positive number in plain notation with two significant digits (0.0032, 0.1, 25).
+/// A positive number with two significant digits, in plain notation (0.0032, 0.1, 25) down to
+/// 10^-4 and in scientific notation below (3.2e-5, 1e-8).
 fn significant(x: f64) -> String {
+    if x < 1e-4 {
+        let text = format!("{x:.1e}");
+        return text.replacen(".0e", "e", 1);
+    }
     let decimals = (1 - x.log10().floor() as i32).max(0) as usize;
     let text = format!("{x:.decimals$}");
     if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_string() } else { text }
@@ -289,9 +291,10 @@ impl HeatFigure<'_> {
     fn title(&self) -> String {
         let hemisphere = if self.hemisphere == "T" { "transmission" } else { "reflection" };
         format!(
-            "{}, θ_i = {:.1}°: f over the {hemisphere} hemisphere (light from +x){}",
+            "{}, θ_i = {:.1}°: f over the {hemisphere} hemisphere (light from +x){}{}",
             surface_label(self.run, self.case),
             self.case.theta_i_deg,
+            if self.selection.log { ", log colour scale" } else { "" },
             self.selection.suffix()
         )
     }
@@ -307,7 +310,15 @@ impl HeatFigure<'_> {
                    standard error of at most 30% counts with its value, a noisier one with its value less one \
                    standard error. Bins above the top, all noisy (near the horizon, where a bin's projected solid \
                    angle is small, one photon makes a large f), are drawn in the top colour, and the panel's title \
-                   counts them (\"bins above scale\").";
+                   counts them (\"bins above scale\"). Blobs in sparse orders and a star around the pole, where \
+                   the innermost ring's wedges are a few pixels wide, are the bins' noise, not lobe structure \
+                   (docs/figures.md).";
+        let grazing = if self.selection.log || self.case.theta_i_deg < 75.0 {
+            ""
+        } else {
+            " At grazing incidence the lobe peaks at the rim and a linear scale leaves the rest of the disc \
+             dark: `smithwalk plot --log` shows both."
+        };
         let (hemisphere, mirror) = if self.hemisphere == "T" {
             ("transmission", "")
         } else {
@@ -316,7 +327,7 @@ impl HeatFigure<'_> {
         format!(
             "Case {} ({}, θ_i = {:.1}°), {hemisphere}: the BSDF f (1/sr) per bounce order over the projected hemisphere, \
              x = sin θ_o cos φ_o, y = sin θ_o sin φ_o with φ_o from the incident azimuth (the light comes from +x{mirror}). \
-             Each pixel is interpolated between the centres of the detector bins around its direction (linearly in |cos θ_o| and φ_o; at the pole, the mean of the innermost ring), on {scale}. {top}{}{}",
+             Each pixel is interpolated between the centres of the detector bins around its direction (linearly in |cos θ_o| and φ_o; at the pole, the mean of the innermost ring), on {scale}. {top}{grazing}{}{}",
             self.case.index,
             surface_label(self.run, self.case),
             self.case.theta_i_deg,
@@ -366,6 +377,8 @@ mod tests {
         assert_eq!(significant(0.001), "0.001");
         assert_eq!(significant(0.000316), "0.00032");
         assert_eq!(significant(25.0), "25");
+        assert_eq!(significant(1e-8), "1e-8");
+        assert_eq!(significant(3.16e-5), "3.2e-5");
     }
 
     /// A one-photon bin at the rim (relative standard error 1) does not set the scale; a

@@ -126,7 +126,10 @@ impl LobeFigure<'_> {
             let fill = line.colour.mix(BAND_OPACITY).filled();
             chart.draw_series(bands(curve, top).into_iter().map(|b| Polygon::new(b, fill))).map_err(draw_err)?;
         }
-        for (line, curve, _) in &lines {
+        // The Monte Carlo models' noisy lines first, so that the closed-form ones (`single`, the
+        // exact oracle of order 1) stay visible on top of them.
+        let (noisy, exact): (Vec<_>, Vec<_>) = lines.iter().partition(|l| l.2);
+        for (line, curve, _) in noisy.into_iter().chain(exact) {
             let curve: Vec<(f64, f64)> = curve.iter().map(|p| (p.0, p.1)).collect();
             style::draw_line(chart.plotting_area(), &curve, *line)?;
         }

@@ -28,9 +28,9 @@ pub(super) struct Section<'a> {
     pub heats: Vec<Drawn>,
 }
 
-/// A p-value for the tables: `0` where it underflowed, else three significant digits.
+/// A p-value as the console prints it (`<1e-300` below what a double holds), for HTML.
 fn p_text(p: f64) -> String {
-    if p == 0.0 { "0".into() } else { format!("{p:.2e}") }
+    escape(&crate::analysis::compare::p_value_text(p))
 }
 
 fn escape(text: &str) -> String {
@@ -267,4 +267,14 @@ pub(super) fn page(
     }
     html.push_str("</body></html>\n");
     Ok(html)
+}
+
+#[cfg(test)]
+mod tests {
+    /// An underflowed p-value reads as the console's bound (it read `0`, a false value), escaped.
+    #[test]
+    fn an_underflowed_p_value_is_a_bound_in_html() {
+        assert_eq!(super::p_text(0.0), "&lt;1e-300");
+        assert_eq!(super::p_text(9.28e-4), "9.28e-4");
+    }
 }
