@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-/// Makes sure `dir` exists and is writable, before any simulation time is spent.
+/// Makes sure `dir` exists and is writable, before any simulation time is spent. Errors name
+/// the directory, not the command-line option that gave it (the Python package calls this too).
 pub fn prepare_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("--out {}: cannot create the output directory", dir.display()))?;
-    temp_file(dir).with_context(|| format!("--out {}: the output directory is not writable", dir.display()))?;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create the output directory {}", dir.display()))?;
+    temp_file(dir).with_context(|| format!("the output directory {} is not writable", dir.display()))?;
     Ok(())
 }
 
@@ -80,7 +80,10 @@ pub fn write_file_atomically(out: &Path, bytes: Vec<u8>) -> Result<PathBuf> {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let name = out.file_name().and_then(|n| n.to_str()).context("--out needs a file name")?;
+    let name = out
+        .file_name()
+        .and_then(|n| n.to_str())
+        .with_context(|| format!("the output {} needs a file name", out.display()))?;
     prepare_dir(dir)?;
     let written = write_atomically(dir, &[(name, bytes)])?;
     Ok(written.into_iter().next().expect("one file"))
@@ -119,4 +122,19 @@ fn make_readable(file: &std::fs::File) -> std::io::Result<()> {
 #[cfg(not(unix))]
 fn make_readable(_file: &std::fs::File) -> std::io::Result<()> {
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    /// An output directory that is an existing file is refused by its path, in words that fit
+    /// the command line and the Python package alike (it named `--out` to Python users).
+    #[test]
+    fn an_output_directory_that_is_a_file_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("taken");
+        std::fs::write(&file, "x").unwrap();
+        let e = format!("{:#}", super::prepare_dir(&file).unwrap_err());
+        assert!(e.starts_with(&format!("cannot create the output directory {}: ", file.display())), "{e}");
+        assert!(!e.contains("--out"), "{e}");
+    }
 }

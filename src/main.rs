@@ -200,6 +200,15 @@ fn bench(paths: u64, repeats: usize) -> Result<()> {
     }
     let cores = std::thread::available_parallelism().map_or(1, usize::from);
     let mut out = std::io::stdout().lock();
+    let legend = format!(
+        "Per case, {paths} photons, the fastest of --repeats {repeats}: paths/s per core on 1 thread; ns per facet \
+         interaction (bounce); facet interactions per path; the 2-thread over the 1-thread rate; two independent \
+         1-thread runs at once over one alone (what this machine gives two workers, the ceiling of the scaling); \
+         the cores the 2-thread run kept busy (docs/performance.md)."
+    );
+    if !print_line(&mut out, &legend)? {
+        return Ok(());
+    }
     let header = format!(
         "{:<36} {:>14} {:>12} {:>10} {:>14} {:>14} {:>12}",
         "case", "paths/s/core", "ns/bounce", "bounces", "scaling 1->2", "two 1-thread", "busy cores"

@@ -192,6 +192,11 @@ def test_bad_arguments(tmp_path):
         smithwalk.run(MONO, threads=0)
     with pytest.raises(ValueError, match=r"`seed` = -1 is not allowed"):
         smithwalk.run(MONO, seed=-1)
+    # The smallest allowed value, not 0, for counts that must be at least 2 or 1.
+    with pytest.raises(ValueError, match=r"`paths` = -5 is not allowed: an integer >= 2"):
+        smithwalk.run(MONO, paths=-5)
+    with pytest.raises(ValueError, match=r"`threads` = -1 is not allowed: an integer >= 1"):
+        smithwalk.run(MONO, threads=-1)
     with pytest.raises(TypeError, match="must be an integer"):
         smithwalk.run(MONO, paths=1e5)
     with pytest.raises(TypeError, match="TOML string, a path or a dict"):

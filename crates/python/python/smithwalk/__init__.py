@@ -70,7 +70,7 @@ def _config_source(config):
 
 
 def _unsigned(name, value, *, minimum=0):
-    """An optional non-negative integer argument, checked with the command line's wording."""
+    """An optional integer argument of at least `minimum`, checked with the command line's wording."""
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
@@ -280,7 +280,7 @@ class RunResult:
         with tempfile.TemporaryDirectory(prefix="smithwalk-compare-") as tmp:
             self._files_into(tmp)
             report = _native.compare(
-                tmp, models, _unsigned("paths", paths), _unsigned("threads", threads)
+                tmp, models, _unsigned("paths", paths, minimum=2), _unsigned("threads", threads, minimum=1)
             )
             files = {name: (Path(tmp) / name).read_bytes() for name in _COMPARE_FILES}
             lobes = _native.read_models(tmp)
@@ -375,9 +375,9 @@ def run(config, *, paths=None, seed=None, threads=None, progress=False):
     native = _native.run(
         source,
         kind,
-        _unsigned("paths", paths),
+        _unsigned("paths", paths, minimum=2),
         _unsigned("seed", seed),
-        _unsigned("threads", threads),
+        _unsigned("threads", threads, minimum=1),
         bool(progress),
     )
     result = RunResult._of_native(native)
