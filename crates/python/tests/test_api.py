@@ -279,7 +279,10 @@ def test_the_walk_releases_the_gil():
 def test_ctrl_c_stops_a_run(tmp_path):
     """SIGINT in the middle of a long run raises KeyboardInterrupt within a round of chunks."""
     script = (
-        "import sys, smithwalk\n"
+        "import signal, sys, smithwalk\n"
+        # A job started in the background of a script inherits SIGINT ignored, and Python then
+        # installs no handler: restore Python's, which is what a user at a terminal has.
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         "print('walking', flush=True)\n"
         f"smithwalk.run({MONO!r}, paths=10**9, threads=1)\n"
         "print('finished', flush=True)\n"
