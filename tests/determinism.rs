@@ -145,7 +145,7 @@ fn unwritable_output_directory_is_rejected_before_running() {
     let result = smithwalk(&["run", config.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&result.stderr);
     assert!(!result.status.success());
-    assert!(stderr.contains("--out") && stderr.contains("blocker"), "{stderr}");
+    assert!(stderr.contains("cannot create the output directory") && stderr.contains("blocker"), "{stderr}");
 }
 
 #[test]
