@@ -160,6 +160,16 @@ fn a_precision_target_stops_cells_early() {
     }
 }
 
+/// The error of loading `toml` as a table config from a file, and the prefix that names that
+/// file (`config <path> is not valid: `).
+fn load_error(toml: &str) -> (String, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("t.toml");
+    std::fs::write(&path, toml).unwrap();
+    let err = LutConfig::load(&path).expect_err(toml).to_string();
+    (err, format!("config {} is not valid: ", path.display()))
+}
+
 #[test]
 fn bad_table_configs_name_the_field() {
     let cases = [
@@ -173,13 +183,10 @@ fn bad_table_configs_name_the_field() {
         ("table = \"conductor\"\npaths = 1\n", "`paths` = 1"),
     ];
     for (toml, field) in cases {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("t.toml");
-        std::fs::write(&path, toml).unwrap();
-        let err = LutConfig::load(&path).expect_err(toml).to_string();
+        let (err, prefix) = load_error(toml);
         assert!(err.contains(field) && err.contains("not allowed"), "{toml}: {err}");
         // Like a run's config, a table's names the file the value is in.
-        assert!(err.starts_with(&format!("config {} is not valid: ", path.display())), "{toml}: {err}");
+        assert!(err.starts_with(&prefix), "{toml}: {err}");
     }
 }
 
@@ -192,11 +199,8 @@ fn a_table_config_that_does_not_read_gets_one_line_naming_the_key() {
         ("paths = 10\n", "`table` is missing: the table config's facet, \"conductor\", \"dielectric\" or \"hammon\""),
     ];
     for (toml, expected) in cases {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("t.toml");
-        std::fs::write(&path, toml).unwrap();
-        let err = LutConfig::load(&path).expect_err(toml).to_string();
-        assert!(err.starts_with(&format!("config {} is not valid: ", path.display())), "{toml}: {err}");
+        let (err, prefix) = load_error(toml);
+        assert!(err.starts_with(&prefix), "{toml}: {err}");
         assert!(err.contains(expected) && !err.contains('\n'), "{toml}: {err}");
     }
 }
