@@ -127,6 +127,28 @@ pub enum ConductorFresnel<const C: usize> {
     Exact { eta: [f64; C], k: [f64; C] },
 }
 
+impl<const C: usize> ConductorFresnel<C> {
+    /// The reflectance of every channel for the cosine `c` between the incident direction and
+    /// the facet normal (§4.2).
+    #[inline]
+    pub fn reflectances(&self, c: f64) -> [f64; C] {
+        match *self {
+            ConductorFresnel::None => [1.0; C],
+            ConductorFresnel::Schlick { f0 } => f0.map(|f0| fresnel::schlick(f0, c)),
+            ConductorFresnel::Exact { eta, k } => std::array::from_fn(|i| fresnel::conductor(eta[i], k[i], c)),
+        }
+    }
+
+    /// The reflectance of channel `channel` alone (see [`ConductorFresnel::reflectances`]).
+    pub fn reflectance(&self, channel: usize, c: f64) -> f64 {
+        match *self {
+            ConductorFresnel::None => 1.0,
+            ConductorFresnel::Schlick { f0 } => fresnel::schlick(f0[channel], c),
+            ConductorFresnel::Exact { eta, k } => fresnel::conductor(eta[channel], k[channel], c),
+        }
+    }
+}
+
 /// Mirror facets that reflect `F` and absorb the rest (§4.2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Conductor<const C: usize> {
@@ -135,12 +157,7 @@ pub struct Conductor<const C: usize> {
 
 impl<const C: usize> Facet<C> for Conductor<C> {
     fn interact<R: Rng + ?Sized>(&self, w: DVec3, m: DVec3, _side: Side, _rng: &mut R) -> Interaction<C> {
-        let c = w.dot(m);
-        let weight = match self.fresnel {
-            ConductorFresnel::None => [1.0; C],
-            ConductorFresnel::Schlick { f0 } => f0.map(|f0| fresnel::schlick(f0, c)),
-            ConductorFresnel::Exact { eta, k } => std::array::from_fn(|i| fresnel::conductor(eta[i], k[i], c)),
-        };
+        let weight = self.fresnel.reflectances(w.dot(m));
         Interaction::One(Branch { dir: reflect(w, m), weight, crosses: false })
     }
 
@@ -158,14 +175,7 @@ impl<const C: usize> Facet<C> for Conductor<C> {
         _rng: &mut R,
     ) -> [f64; C] {
         match mirror_density(ndf, w, d) {
-            Some((density, c)) if !crosses => {
-                let f: [f64; C] = match self.fresnel {
-                    ConductorFresnel::None => [1.0; C],
-                    ConductorFresnel::Schlick { f0 } => f0.map(|f0| fresnel::schlick(f0, c)),
-                    ConductorFresnel::Exact { eta, k } => std::array::from_fn(|i| fresnel::conductor(eta[i], k[i], c)),
-                };
-                f.map(|f| f * density)
-            }
+            Some((density, c)) if !crosses => self.fresnel.reflectances(c).map(|f| f * density),
             _ => [0.0; C],
         }
     }

@@ -11,6 +11,7 @@
 //! * [`normals`]: how the facet hit by a ray is drawn (visible normals or Hammon's rejection);
 //! * [`fresnel`]: Fresnel reflectances;
 //! * [`facet`]: the micro-BSDF of a single facet (conductor, dielectric, Lambertian, Hammon);
+//! * [`material`]: a facet material chosen at run time, dispatching to its micro-BSDF;
 //! * [`walk`]: the random walk of Heitz et al. 2016 that composes them;
 //! * [`single`]: exact single scattering, the walk's order-1 oracle;
 //! * [`beta`]: the Beta function of transmitted masking, exact towards the horizon;
@@ -30,6 +31,7 @@ pub mod chain;
 pub mod facet;
 pub mod fresnel;
 pub mod height;
+pub mod material;
 pub mod ndf;
 pub mod nee;
 pub mod normals;

@@ -77,10 +77,10 @@ pub trait Ndf: Copy + Send + Sync {
 
     /// Slope radius `r = tan(theta_m)` of a normal drawn from `D(m) m_z` in the roughness-1
     /// configuration, as a function of a uniform `u` (the inverse of [`Ndf::std_slope_cdf`]).
-    fn std_slope_radius(u: f64) -> f64;
+    fn std_slope_radius(&self, u: f64) -> f64;
 
     /// Probability that a normal drawn from `D(m) m_z` (roughness 1) has slope radius below `r`.
-    fn std_slope_cdf(r: f64) -> f64;
+    fn std_slope_cdf(&self, r: f64) -> f64;
 }
 
 /// Anisotropic GGX (Trowbridge–Reitz), §1.2.
@@ -137,11 +137,11 @@ impl Ndf for Ggx {
     }
 
     /// `cos^2 theta = 1 - u` for roughness 1 (\[Ham17\], "Intersection normal"), so `tan^2 = u / (1 - u)`.
-    fn std_slope_radius(u: f64) -> f64 {
+    fn std_slope_radius(&self, u: f64) -> f64 {
         (u / (1.0 - u)).sqrt()
     }
 
-    fn std_slope_cdf(r: f64) -> f64 {
+    fn std_slope_cdf(&self, r: f64) -> f64 {
         let r2 = r * r;
         if r2.is_infinite() { 1.0 } else { r2 / (1.0 + r2) }
     }
@@ -245,12 +245,77 @@ impl Ndf for Beckmann {
     }
 
     /// `tan^2 theta = -ln(1 - u)` for roughness 1.
-    fn std_slope_radius(u: f64) -> f64 {
+    fn std_slope_radius(&self, u: f64) -> f64 {
         (-(-u).ln_1p()).sqrt()
     }
 
-    fn std_slope_cdf(r: f64) -> f64 {
+    fn std_slope_cdf(&self, r: f64) -> f64 {
         -(-r * r).exp_m1()
+    }
+}
+
+/// One of the NDFs, chosen at run time (a configuration's or a renderer's `distribution`).
+///
+/// Every quantity dispatches to the variant. Hot loops that want each NDF compiled on its own
+/// match once outside the loop and call the variant's type directly; adding an NDF is one
+/// variant here, and the compiler lists every `match` to extend.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AnyNdf {
+    Ggx(Ggx),
+    Beckmann(Beckmann),
+}
+
+impl AnyNdf {
+    /// The NDF's name as configurations spell it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            AnyNdf::Ggx(_) => "ggx",
+            AnyNdf::Beckmann(_) => "beckmann",
+        }
+    }
+}
+
+/// Calls `$body` with `$n` bound to the concrete NDF inside an [`AnyNdf`].
+macro_rules! dispatch {
+    ($any:expr, $n:ident => $body:expr) => {
+        match $any {
+            AnyNdf::Ggx($n) => $body,
+            AnyNdf::Beckmann($n) => $body,
+        }
+    };
+}
+
+impl Ndf for AnyNdf {
+    fn roughness(&self) -> Roughness {
+        dispatch!(self, n => n.roughness())
+    }
+
+    fn d(&self, m: DVec3) -> f64 {
+        dispatch!(self, n => n.d(m))
+    }
+
+    fn lambda(&self, w: DVec3) -> f64 {
+        dispatch!(self, n => n.lambda(w))
+    }
+
+    fn projected_area(&self, w: DVec3) -> f64 {
+        dispatch!(self, n => n.projected_area(w))
+    }
+
+    fn sample_visible<R: Rng + ?Sized>(&self, w: DVec3, rng: &mut R) -> DVec3 {
+        dispatch!(self, n => n.sample_visible(w, rng))
+    }
+
+    fn sample_visible_lanes<R: Rng + ?Sized, const L: usize>(&self, w: [DVec3; L], rng: &mut R) -> [DVec3; L] {
+        dispatch!(self, n => n.sample_visible_lanes(w, rng))
+    }
+
+    fn std_slope_radius(&self, u: f64) -> f64 {
+        dispatch!(self, n => n.std_slope_radius(u))
+    }
+
+    fn std_slope_cdf(&self, r: f64) -> f64 {
+        dispatch!(self, n => n.std_slope_cdf(r))
     }
 }
 

@@ -64,7 +64,7 @@ fn hammon_rejection<N: Ndf, R: Rng + ?Sized>(ndf: &N, d: DVec3, rng: &mut R) -> 
     let t = roughness.stretch(d);
     let t_h = t.x.hypot(t.y);
     let (cos_b, sin_b) = if t_h > 0.0 { (t.x / t_h, t.y / t_h) } else { (1.0, 0.0) };
-    let x1_min = if t.z > 0.0 { if t_h > 0.0 { N::std_slope_cdf(t.z / t_h) } else { 1.0 } } else { 0.0 };
+    let x1_min = if t.z > 0.0 { if t_h > 0.0 { ndf.std_slope_cdf(t.z / t_h) } else { 1.0 } } else { 0.0 };
     if x1_min >= 1.0 {
         // Travelling straight up: no facet faces the ray (A(-z) = 0, §10).
         return DVec3::Z;
@@ -72,7 +72,7 @@ fn hammon_rejection<N: Ndf, R: Rng + ?Sized>(ndf: &N, d: DVec3, rng: &mut R) -> 
     loop {
         let phi = 2.0 * PI * open01(rng);
         let x1 = x1_min + (1.0 - x1_min) * open01(rng);
-        let r = N::std_slope_radius(x1);
+        let r = ndf.std_slope_radius(x1);
         let (s, c) = phi.sin_cos();
         let m_local = DVec3::new(c * r, s * r, 1.0);
         if t_h * m_local.x + t.z * m_local.z < 0.0 {

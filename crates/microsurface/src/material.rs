@@ -1,0 +1,87 @@
+//! A facet material chosen at run time: one of the micro-BSDFs of [`crate::facet`] with its
+//! Fresnel data (docs/theory.md §4.2–§4.5).
+//!
+//! Configurations and renderers pick a material by name; the walk is generic over
+//! [`Facet`]. [`Material`] is that choice as a value, and implements [`Facet`] by dispatching
+//! to its variant, so that code which does not need each material compiled on its own (a
+//! renderer's BSDF, a model's bin integral) takes a `Material` directly. Adding a material is
+//! one variant here and one `Facet` implementation; the compiler lists every `match` to extend.
+
+use glam::DVec3;
+use rand::Rng;
+
+use crate::facet::{Conductor, Dielectric, Facet, Hammon, Interaction, Lambertian, Side};
+use crate::ndf::Ndf;
+
+/// The micro-BSDF of every facet, with `C` colour channels (1 or 3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Material<const C: usize> {
+    /// Mirror facets with a conductor's Fresnel reflectance (§4.2).
+    Conductor(Conductor<C>),
+    /// Smooth dielectric facets of relative index `eta = n_inside / n_outside` (§4.3).
+    Dielectric(Dielectric),
+    /// Lambertian facets (§4.4).
+    Lambertian(Lambertian<C>),
+    /// Hammon 2017's specular-plus-diffuse facets (§4.5).
+    Hammon(Hammon<C>),
+}
+
+impl<const C: usize> Material<C> {
+    /// Whether light can pass to the other side of the surface (only dielectrics transmit).
+    pub fn transmits(&self) -> bool {
+        matches!(self, Material::Dielectric(_))
+    }
+
+    /// The material's kind as configurations spell it.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Material::Conductor(_) => "conductor",
+            Material::Dielectric(_) => "dielectric",
+            Material::Lambertian(_) => "diffuse",
+            Material::Hammon(_) => "hammon",
+        }
+    }
+
+    /// The Fresnel reflectance of a conductor's facets in channel `channel` for the cosine `c`
+    /// between the incident direction and the facet normal; `None` for other materials.
+    pub fn conductor_fresnel(&self, channel: usize, c: f64) -> Option<f64> {
+        match self {
+            Material::Conductor(conductor) => Some(conductor.fresnel.reflectance(channel, c)),
+            _ => None,
+        }
+    }
+}
+
+/// Calls `$body` with `$f` bound to the facet inside a [`Material`].
+macro_rules! dispatch {
+    ($material:expr, $f:ident => $body:expr) => {
+        match $material {
+            Material::Conductor($f) => $body,
+            Material::Dielectric($f) => $body,
+            Material::Lambertian($f) => $body,
+            Material::Hammon($f) => $body,
+        }
+    };
+}
+
+impl<const C: usize> Facet<C> for Material<C> {
+    fn interact<R: Rng + ?Sized>(&self, w: DVec3, m: DVec3, side: Side, rng: &mut R) -> Interaction<C> {
+        dispatch!(self, f => f.interact(w, m, side, rng))
+    }
+
+    fn may_split(&self) -> bool {
+        dispatch!(self, f => Facet::<C>::may_split(f))
+    }
+
+    fn phase<N: Ndf, R: Rng + ?Sized>(
+        &self,
+        ndf: &N,
+        w: DVec3,
+        d: DVec3,
+        side: Side,
+        crosses: bool,
+        rng: &mut R,
+    ) -> [f64; C] {
+        dispatch!(self, f => f.phase(ndf, w, d, side, crosses, rng))
+    }
+}
