@@ -18,8 +18,8 @@ use smithwalk::analysis::albedo_table::{AlbedoTable, linear};
 use smithwalk::analysis::compensation::*;
 use smithwalk::analysis::quadrature::gauss_legendre;
 use smithwalk::engine::detector::Grid;
-use smithwalk::microsurface::ndf::Ggx;
-use smithwalk::setup::cases::Case;
+use smithwalk::microsurface::ndf::{AnyNdf, Ggx, Roughness};
+use smithwalk::setup::cases::{Case, expand};
 use smithwalk::setup::config::*;
 
 const GRID: Grid = Grid { cos_bins: 8, phi_bins: 8 };
@@ -34,20 +34,12 @@ const ALPHA_RANGE: (f64, f64) = (0.25, 0.75);
 /// The tolerance of each exact `E` evaluation of the table.
 const TOL: f64 = 1e-8;
 
+/// A GGX conductor with F = 1 of roughness `alpha`, lit from `theta` degrees.
 fn case(alpha: f64, theta: f64) -> Case {
-    Case {
-        index: 0,
-        ndf: NdfKind::Ggx,
-        alpha_x: alpha,
-        alpha_y: alpha,
-        height: HeightKind::Uniform,
-        smith: SmithKind::Exact,
-        normals: NormalsKind::Vndf,
-        material: MaterialConfig::Conductor { fresnel: FresnelKind::None, f0: None, eta: None, k: None, name: None },
-        theta_i_deg: theta,
-        phi_i_deg: 0.0,
-        side: IncidentSide::Outside,
-    }
+    let toml = format!(
+        "paths = 2\n[surface]\nalpha = {alpha}\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = {theta}\n"
+    );
+    expand(&Config::parse(&toml).unwrap()).unwrap().remove(0)
 }
 
 fn alpha_node(i: usize) -> f64 {
@@ -130,7 +122,7 @@ fn a_fine_table_reproduces_the_exact_models_and_a_coarse_one_does_not() {
     for (alpha, theta) in [(0.4, 0.0), (0.6, 70.0)] {
         let c = case(alpha, theta);
         let mut exact_cache = AlbedoCache::default();
-        let exact_albedo = exact_cache.get(NdfKind::Ggx, alpha, Fresnel::One).clone();
+        let exact_albedo = exact_cache.get(AnyNdf::Ggx(Ggx(Roughness::isotropic(alpha))), Fresnel::One).clone();
         let errors = [&fine, &coarse].map(|t| albedo_error(&t.albedo(alpha), &exact_albedo, 0.0));
         let above = [&fine, &coarse].map(|t| albedo_error(&t.albedo(alpha), &exact_albedo, 0.1));
         eprintln!(

@@ -25,7 +25,7 @@ use smithwalk::analysis::quadrature::{gauss_legendre, integrate, integrate_2d};
 use smithwalk::engine::detector::{Grid, Hemisphere};
 use smithwalk::microsurface::DVec3;
 use smithwalk::microsurface::ndf::{Beckmann, Ggx};
-use smithwalk::setup::cases::Case;
+use smithwalk::setup::cases::{Case, expand};
 use smithwalk::setup::config::*;
 
 /// The tolerance of every direct E(mu) evaluation here.
@@ -46,20 +46,17 @@ fn gold() -> MaterialConfig {
     }
 }
 
+/// A case of `material` on an isotropic `ndf` of roughness `alpha`, lit from `theta` degrees.
 fn case(ndf: NdfKind, alpha: f64, theta: f64, material: MaterialConfig) -> Case {
-    Case {
-        index: 0,
-        ndf,
-        alpha_x: alpha,
-        alpha_y: alpha,
-        height: HeightKind::Uniform,
-        smith: SmithKind::Exact,
-        normals: NormalsKind::Vndf,
-        material,
-        theta_i_deg: theta,
-        phi_i_deg: 0.0,
-        side: IncidentSide::Outside,
-    }
+    let mut config = Config::parse(
+        "paths = 2\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 0\n",
+    )
+    .unwrap();
+    config.surface.ndf = OneOrMany::One(ndf);
+    config.surface.alpha = OneOrMany::One(Alpha::Isotropic(alpha));
+    config.material = OneOrMany::One(material);
+    config.incident.theta_deg = Some(OneOrMany::One(theta));
+    expand(&config).unwrap().remove(0)
 }
 
 fn dir(theta_deg: f64, phi_deg: f64) -> DVec3 {
@@ -252,7 +249,7 @@ fn the_order_one_part_of_every_model_is_single_scattering() {
         for material in [conductor(FresnelKind::None, None), conductor(FresnelKind::Schlick, Some(0.3))] {
             let c = case(ndf, alpha, theta, material.clone());
             let single = single_scattering_bins(&c, &GRID, Hemisphere::R, 0, 1e-10).unwrap();
-            let f = Fresnel::channels::<1>(&material).unwrap()[0];
+            let f = Fresnel::channels::<1>(&c.material).unwrap()[0];
             let (e, ef) = (e_table(ndf, alpha, Fresnel::One), e_table(ndf, alpha, f));
             let mu_i = theta.to_radians().cos();
             // Kulla-Conty and Fdez-Agüera add lobes that depend on theta_o only: integrate them

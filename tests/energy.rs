@@ -36,9 +36,9 @@ fn bookkeeping_white_furnace_loses_no_weight() {
             let e = EnergyBalance::from_result(result);
             let label = format!(
                 "{ndf} alpha=({},{}) {} theta={}",
-                case.alpha_x,
-                case.alpha_y,
-                case.material.label(),
+                case.roughness().x,
+                case.roughness().y,
+                case.material_label(),
                 case.theta_i_deg
             );
             assert_eq!(e.lost(), 0.0, "{label}: weight lost {e:?}");
@@ -195,11 +195,11 @@ max_order = 3
     for (case, result) in sim.cases.iter().zip(&sim.results) {
         let e = EnergyBalance::from_result(result);
         let label = format!(
-            "{:?} ({}, {}) {} {:?} {}",
-            case.ndf,
-            case.alpha_x,
-            case.alpha_y,
-            case.material.label(),
+            "{} ({}, {}) {} {:?} {}",
+            case.surface.ndf.name(),
+            case.roughness().x,
+            case.roughness().y,
+            case.material_label(),
             case.side,
             case.theta_i_deg
         );
@@ -237,18 +237,24 @@ theta_deg = [0, 89.99]
     let sim = simulate(others, 2);
     for (case, result) in sim.cases.iter().zip(&sim.results) {
         let e = EnergyBalance::from_result(result);
-        let label = format!("{:?} ({}) {} {}", case.ndf, case.alpha_x, case.material.label(), case.theta_i_deg);
+        let label = format!(
+            "{} ({}) {} {}",
+            case.surface.ndf.name(),
+            case.roughness().x,
+            case.material_label(),
+            case.theta_i_deg
+        );
         assert_eq!(e.lost(), 0.0, "{label}: {e:?}");
         for c in 0..e.reflected.len() {
             let (r, se) = (e.reflected[c], e.absorbed_stderr[c]);
             assert!(r.is_finite() && e.transmitted[c] == 0.0, "{label} channel {c}: {e:?}");
-            if case.material.label().contains("conductor") {
+            if case.material_label().contains("conductor") {
                 assert!(r > 0.0 && r < 1.0 - 4.0 * se, "{label} channel {c}: R = {r} +- {se}");
             } else {
                 assert!((r - 1.0).abs() <= 4.0 * se + 1e-12, "{label} channel {c}: R = {r} +- {se}, lossless facet");
             }
         }
-        if case.material.label().contains("conductor") {
+        if case.material_label().contains("conductor") {
             assert!(e.reflected[0] > e.reflected[1] && e.reflected[1] > e.reflected[2], "{label}: R follows F0 {e:?}");
         }
     }

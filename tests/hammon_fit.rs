@@ -17,14 +17,15 @@ mod common;
 use common::dir;
 use smithwalk::analysis::models::{HammonFitPart, hammon_fit_bins, hammon_fit_lobe};
 use smithwalk::engine::detector::Grid;
+use smithwalk::microsurface::ndf::{AnyNdf, Beckmann, Ggx, Roughness};
 use smithwalk::setup::cases::{Case, expand};
-use smithwalk::setup::config::{Config, IncidentSide, NdfKind};
+use smithwalk::setup::config::{Config, IncidentSide};
 
 fn case(alpha: f64, f0: f64, albedo: f64, theta: f64) -> (Case, String) {
     let toml = format!(
         "paths = 1_000_000\nseed = 21\n[surface]\nalpha = {alpha}\n[material]\nkind = \"hammon\"\nf0 = {f0}\nalbedo = {albedo}\n[incident]\ntheta_deg = {theta}\n[detector]\ncos_theta_bins = 16\nphi_bins = 32\nmax_order = 3\n"
     );
-    (expand(&Config::parse(&toml).unwrap())[0].clone(), toml)
+    (expand(&Config::parse(&toml).unwrap()).unwrap().remove(0), toml)
 }
 
 #[test]
@@ -84,8 +85,10 @@ fn the_fit_is_offered_only_for_isotropic_ggx_lit_from_outside() {
     // case is built by hand).
     let grid = Grid { cos_bins: 2, phi_bins: 4 };
     let (isotropic, _) = case(0.5, 0.04, 0.8, 30.0);
-    let beckmann = Case { ndf: NdfKind::Beckmann, ..isotropic.clone() };
-    let anisotropic = Case { alpha_y: 0.3, ..isotropic.clone() };
+    let mut beckmann = isotropic.clone();
+    beckmann.surface.ndf = AnyNdf::Beckmann(Beckmann(isotropic.roughness()));
+    let mut anisotropic = isotropic.clone();
+    anisotropic.surface.ndf = AnyNdf::Ggx(Ggx(Roughness { x: 0.5, y: 0.3 }));
     let inside = Case { side: IncidentSide::Inside, ..isotropic.clone() };
     assert!(hammon_fit_bins(&isotropic, &grid, HammonFitPart::All, 0, 1e-6).is_some());
     for (label, c) in [("beckmann", beckmann), ("anisotropic", anisotropic), ("inside", inside)] {

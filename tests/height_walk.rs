@@ -230,7 +230,7 @@ fn a_walk_in_actual_heights_measures_what_the_optical_depth_walk_measures() {
         );
         let sim = simulate(&toml, 2);
         let walk = mono(&sim, 0);
-        let wi = sim.cases[0].incident_direction();
+        let wi = sim.cases[0].wi;
         let roughness = Roughness { x: c.alpha.0, y: c.alpha.1 };
         let seed = 1700 + i as u64;
         let reference = match (c.ndf, c.material) {

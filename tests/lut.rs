@@ -24,13 +24,14 @@ fn lut(toml: &str) -> Lut {
 
 /// The case of the table's run at (alpha, mu) for the first material and side `outside`.
 fn case_at(lut: &Lut, alpha: f64, mu: f64, eta: Option<f64>) -> Case {
-    let mut case =
-        expand(&lut.config.run_config()).into_iter().find(|c| c.alpha_x == alpha).expect("a case at this alpha");
+    use smithwalk::setup::config::{Alpha, MaterialConfig, OneOrMany};
+    let mut config = lut.config.run_config();
+    config.surface.alpha = OneOrMany::One(Alpha::Isotropic(alpha));
     if let Some(eta) = eta {
-        case.material = smithwalk::setup::config::MaterialConfig::Dielectric { eta, name: None };
+        config.material = OneOrMany::One(MaterialConfig::Dielectric { eta, name: None });
     }
-    case.theta_i_deg = mu.acos().to_degrees();
-    case
+    config.incident.theta_deg = Some(OneOrMany::One(mu.acos().to_degrees()));
+    expand(&config).expect("the table's run config expands").remove(0)
 }
 
 /// Order-1 albedo into `hemisphere` by quadrature of the single-scattering BSDF: adaptive over

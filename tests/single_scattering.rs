@@ -26,7 +26,7 @@ use numerics::quadrature::integrate_2d;
 use smithwalk::analysis::models::{single_scattering_bins, single_scattering_lobe};
 use smithwalk::analysis::stats::{ChiSquare, chi_square, sidak};
 use smithwalk::engine::detector::{Grid, Hemisphere};
-use smithwalk::microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
+use smithwalk::microsurface::ndf::{AnyNdf, Beckmann, Ggx, Ndf, Roughness};
 use smithwalk::microsurface::{DVec3, fresnel, single};
 use smithwalk::setup::cases::{Case, expand};
 use smithwalk::setup::config::{Config, MaterialConfig};
@@ -34,7 +34,7 @@ use std::f64::consts::TAU;
 
 /// The one case of a one-case TOML config.
 fn case_of(toml: &str) -> Case {
-    expand(&Config::parse(toml).unwrap())[0].clone()
+    expand(&Config::parse(toml).unwrap()).unwrap().remove(0)
 }
 
 struct HistogramCase {
@@ -158,8 +158,7 @@ fn a_wrong_lobe_is_rejected() {
     let toml = "paths = 1_000_000\nseed = 9\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 30\n[detector]\ncos_theta_bins = 16\nphi_bins = 32\nmax_order = 2\n";
     let sim = simulate(toml, 2);
     let mut other = sim.cases[0].clone();
-    other.alpha_x = 0.55;
-    other.alpha_y = 0.55;
+    other.surface.ndf = AnyNdf::Ggx(Ggx(Roughness::isotropic(0.55)));
     let d = mono(&sim, 0);
     let expected = single_scattering_bins(&other, &d.grid, Hemisphere::R, 0, 1e-10).unwrap();
     let test = chi_square(&weighted_bins(d, 1, Hemisphere::R), &expected, d.tallies.photons, 5.0);
@@ -367,7 +366,7 @@ fn narrow_specular_lobes_are_integrated_where_they_peak() {
                 "paths = 10\n[surface]\nndf = \"{ndf}\"\nalpha = {alpha}\n[material]\n{material}\n[incident]\ntheta_deg = {theta}\nphi_deg = 20\n"
             );
             let case = case_of(&toml);
-            let wi = case.incident_direction();
+            let wi = case.wi;
             let hemispheres: &[Hemisphere] =
                 if eta.is_some() { &[Hemisphere::R, Hemisphere::T] } else { &[Hemisphere::R] };
             let facet = eta.map_or(Facet::Schlick(1.0), Facet::Dielectric);
@@ -467,7 +466,7 @@ fn every_channel_of_an_rgb_run_matches_its_own_single_scattering() {
             let e1 = channel_albedo(d, 1, Hemisphere::R, channel);
             assert_cells_and_albedo(e1, &test, &expected, level, &label);
             assert!(test.p_value > level, "{label}: order 1 rejected\n{}", test.worst_cells(10));
-            let facet = match case.material {
+            let facet = match case.material_spec {
                 MaterialConfig::Conductor { f0: Some(f0), .. } => Some(Facet::Schlick(f0.channel(channel))),
                 MaterialConfig::Conductor { eta: Some(eta), k: Some(k), .. } => {
                     Some(Facet::Conductor { eta: eta.channel(channel), k: k.channel(channel) })
@@ -475,8 +474,8 @@ fn every_channel_of_an_rgb_run_matches_its_own_single_scattering() {
                 _ => None,
             };
             if let Some(facet) = facet {
-                let wi = case.incident_direction();
-                let reference = ggx_order_one_albedo_over_the_normals(case.alpha_x, wi, facet, Hemisphere::R);
+                let wi = case.wi;
+                let reference = ggx_order_one_albedo_over_the_normals(case.roughness().x, wi, facet, Hemisphere::R);
                 println!("{label}: E1 {:.5} +- {:.5}, over the normals {reference:.5}", e1.0, e1.1);
                 assert!(
                     (e1.0 - reference).abs() < two_sided_z(level) * e1.1,

@@ -137,9 +137,9 @@ fn both_models_conserve_energy() {
             assert!(
                 (e.reflected[0] + e.transmitted[0] - 1.0).abs() <= 4.0 * e.absorbed_stderr[0] + 1e-9,
                 "{estimator:?} {} alpha ({}, {}) theta {}: {e:?}",
-                case.material.label(),
-                case.alpha_x,
-                case.alpha_y,
+                case.material_label(),
+                case.roughness().x,
+                case.roughness().y,
                 case.theta_i_deg
             );
         }

@@ -210,7 +210,7 @@ fn folded_slot(config: &Config) -> Option<usize> {
 /// tested once as channel `r` (a material given per channel is tested per channel). A user's
 /// `--external` model may differ between channels whatever the material: all are tested.
 fn is_tested(config: &Config, case: &Case, model: Model, order: usize, channel: usize) -> bool {
-    let channel_of_its_own = channel == 0 || case.material.is_rgb() || model == Model::External;
+    let channel_of_its_own = channel == 0 || case.material_spec.is_rgb() || model == Model::External;
     !(folded_slot(config) == Some(1) && order == 1) && channel_of_its_own
 }
 
@@ -240,7 +240,7 @@ fn closed_form(model: Model, run: &RunDir, measured: &Lobes, progress: &Progress
             Model::Single => hemispheres(case).iter().map(|&h| (1, h)).collect(),
             _ => vec![(0, Hemisphere::R), (1, Hemisphere::R)],
         };
-        let shared: Vec<Vec<usize>> = if case.material.is_rgb() {
+        let shared: Vec<Vec<usize>> = if case.material_spec.is_rgb() {
             (0..channels).map(|c| vec![c]).collect()
         } else {
             vec![(0..channels).collect()]
@@ -1076,7 +1076,7 @@ mod tests {
              [detector]\ncos_theta_bins = 2\nphi_bins = 2\nmax_order = 1\n",
         )
         .unwrap();
-        let case = &crate::setup::cases::expand(&config)[0];
+        let case = &crate::setup::cases::expand(&config).unwrap()[0];
         // max_order = 1: slot 1 is "1+" = slot 0, tested once, and `single` is skipped.
         let single = Model::Single;
         assert!(is_tested(&config, case, single, 0, 0) && !is_tested(&config, case, single, 1, 0));
@@ -1092,7 +1092,7 @@ mod tests {
              [incident]\ntheta_deg = 0\n[detector]\ncos_theta_bins = 2\nphi_bins = 2\n",
         )
         .unwrap();
-        let cases = crate::setup::cases::expand(&config);
+        let cases = crate::setup::cases::expand(&config).unwrap();
         let tested = |case: &Case, model| (0..3).filter(|&c| is_tested(&config, case, model, 1, c)).count();
         assert_eq!((tested(&cases[0], Model::Single), tested(&cases[1], Model::Single)), (1, 3));
         assert_eq!((tested(&cases[0], Model::HeitzNee), tested(&cases[1], Model::KullaConty)), (1, 3));

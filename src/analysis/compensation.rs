@@ -23,16 +23,20 @@
 use std::f64::consts::PI;
 
 use glam::DVec3;
+use microsurface::facet::{Conductor, ConductorFresnel};
 use microsurface::fresnel;
-use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, slope_to_normal};
+use microsurface::material::Material;
+use microsurface::ndf::{AnyNdf, Beckmann, Ggx, Ndf, Roughness, slope_to_normal};
+use microsurface::normals::Normals;
 use microsurface::single;
+use microsurface::smith::Smith;
 
 use crate::analysis::albedo_table::{AlbedoTable, linear};
 use crate::analysis::models::{LobeIntegrals, MAX_BIN_EVALUATIONS, integrate_bins, specular_peak};
 use crate::analysis::quadrature::{gauss_legendre, integrate};
 use crate::engine::detector::{Grid, Hemisphere};
 use crate::setup::cases::Case;
-use crate::setup::config::{FresnelKind, IncidentSide, MaterialConfig, Model, NdfKind, NormalsKind, SmithKind};
+use crate::setup::config::{IncidentSide, Model};
 
 /// A published energy-compensation model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -78,15 +82,12 @@ impl Fresnel {
     }
 
     /// The channels of a conductor material (`C` = 1 or 3), or `None` for other materials.
-    pub fn channels<const C: usize>(material: &MaterialConfig) -> Option<[Fresnel; C]> {
-        let MaterialConfig::Conductor { fresnel: kind, f0, eta, k, .. } = material else { return None };
-        Some(match kind {
-            FresnelKind::None => [Fresnel::One; C],
-            FresnelKind::Schlick => (*f0)?.to_array::<C>().map(Fresnel::Schlick),
-            FresnelKind::Exact => {
-                let (eta, k) = ((*eta)?.to_array::<C>(), (*k)?.to_array::<C>());
-                std::array::from_fn(|c| Fresnel::Conductor { eta: eta[c], k: k[c] })
-            }
+    pub fn channels<const C: usize>(material: &Material<3>) -> Option<[Fresnel; C]> {
+        let Material::Conductor(Conductor { fresnel }) = material.channels::<C>() else { return None };
+        Some(match fresnel {
+            ConductorFresnel::None => [Fresnel::One; C],
+            ConductorFresnel::Schlick { f0 } => f0.map(Fresnel::Schlick),
+            ConductorFresnel::Exact { eta, k } => std::array::from_fn(|c| Fresnel::Conductor { eta: eta[c], k: k[c] }),
         })
     }
 }
@@ -462,7 +463,7 @@ impl<'a, N: Ndf> Compensated<'a, N> {
 /// model of a comparison.
 #[derive(Default)]
 pub struct AlbedoCache {
-    entries: Vec<((NdfKind, f64, Fresnel), Albedo)>,
+    entries: Vec<((AnyNdf, Fresnel), Albedo)>,
     /// A user's table of `E` and `E_avg` with F = 1 (`--albedo-table`), read in place of the
     /// exact functions with F = 1 whatever the NDF; `E_F` with another Fresnel stays exact.
     table: Option<AlbedoTable>,
@@ -474,15 +475,16 @@ impl AlbedoCache {
         AlbedoCache { entries: Vec::new(), table: Some(table) }
     }
 
-    pub fn get(&mut self, ndf: NdfKind, alpha: f64, f: Fresnel) -> &Albedo {
-        let key = (ndf, alpha, f);
+    /// The albedo functions of an isotropic `ndf` with reflectance `f`.
+    pub fn get(&mut self, ndf: AnyNdf, f: Fresnel) -> &Albedo {
+        let key = (ndf, f);
         let index = match self.entries.iter().position(|(k, _)| *k == key) {
             Some(i) => i,
             None => {
                 let albedo = match (&self.table, ndf) {
-                    (Some(table), _) if f == Fresnel::One => table.albedo(alpha),
-                    (_, NdfKind::Ggx) => Albedo::exact(&Ggx::with_alpha(alpha), f),
-                    (_, NdfKind::Beckmann) => Albedo::exact(&Beckmann::with_alpha(alpha), f),
+                    (Some(table), _) if f == Fresnel::One => table.albedo(ndf.roughness().x),
+                    (_, AnyNdf::Ggx(ndf)) => Albedo::exact(&ndf, f),
+                    (_, AnyNdf::Beckmann(ndf)) => Albedo::exact(&ndf, f),
                 };
                 self.entries.push((key, albedo));
                 self.entries.len() - 1
@@ -495,10 +497,11 @@ impl AlbedoCache {
 /// Whether a case is one the compensation models describe: a conductor on an isotropic
 /// surface with the true Smith Lambda and visible normals, lit from outside.
 pub fn applies(case: &Case) -> bool {
-    matches!(case.material, MaterialConfig::Conductor { .. })
-        && case.alpha_x == case.alpha_y
-        && case.smith == SmithKind::Exact
-        && case.normals == NormalsKind::Vndf
+    let Roughness { x, y } = case.roughness();
+    matches!(case.material, Material::Conductor(_))
+        && x == y
+        && case.surface.smith == Smith::Exact
+        && case.surface.normals == Normals::Visible
         && case.side == IncidentSide::Outside
 }
 
@@ -517,9 +520,8 @@ pub fn compensated_bins<const C: usize>(
         return None;
     }
     let channels = Fresnel::channels::<C>(&case.material)?;
-    let alpha = case.alpha_x;
-    let albedo = cache.get(case.ndf, alpha, Fresnel::One).clone();
-    let wi = case.incident_direction();
+    let (ndf, wi) = (case.surface.ndf, case.wi);
+    let albedo = cache.get(ndf, Fresnel::One).clone();
     let peak = specular_peak(case, Hemisphere::R);
     let rule = (peak, tolerance, MAX_BIN_EVALUATIONS);
     let mut done: Vec<(Fresnel, LobeIntegrals)> = Vec::new();
@@ -529,16 +531,16 @@ pub fn compensated_bins<const C: usize>(
             return lobe.clone();
         }
         let albedo_fresnel = match model {
-            Compensation::FdezAguera => cache.get(case.ndf, alpha, f).clone(),
+            Compensation::FdezAguera => cache.get(ndf, f).clone(),
             _ => albedo.clone(),
         };
-        let lobe = match case.ndf {
-            NdfKind::Ggx => {
-                let lobe = Compensated::new(model, Ggx::with_alpha(alpha), f, &albedo, &albedo_fresnel);
+        let lobe = match ndf {
+            AnyNdf::Ggx(ndf) => {
+                let lobe = Compensated::new(model, ndf, f, &albedo, &albedo_fresnel);
                 integrate_bins(case, grid, Hemisphere::R, rule, |wo| lobe.bsdf(wi, wo) * wo.z)
             }
-            NdfKind::Beckmann => {
-                let lobe = Compensated::new(model, Beckmann::with_alpha(alpha), f, &albedo, &albedo_fresnel);
+            AnyNdf::Beckmann(ndf) => {
+                let lobe = Compensated::new(model, ndf, f, &albedo, &albedo_fresnel);
                 integrate_bins(case, grid, Hemisphere::R, rule, |wo| lobe.bsdf(wi, wo) * wo.z)
             }
         };

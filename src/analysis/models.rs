@@ -7,16 +7,19 @@
 use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
-use microsurface::facet::{reflect, refract};
+use microsurface::facet::{Conductor, Dielectric, Hammon, Lambertian, reflect, refract};
 use microsurface::fresnel;
-use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness, slope_to_normal};
+use microsurface::material::Material;
+use microsurface::ndf::{AnyNdf, Beckmann, Ggx, Ndf, Roughness, slope_to_normal};
+use microsurface::normals::Normals;
 use microsurface::single;
+use microsurface::smith::Smith;
 use rayon::prelude::*;
 
 use crate::analysis::quadrature::{Peak, cubature, gauss_legendre};
 use crate::engine::detector::{Grid, Hemisphere};
 use crate::setup::cases::Case;
-use crate::setup::config::{FresnelKind, IncidentSide, MaterialConfig, NdfKind, NormalsKind, SmithKind};
+use crate::setup::config::IncidentSide;
 
 /// The outgoing direction of a bin coordinate: `|cos theta| = u`, azimuth `phi` from the
 /// incident azimuth `phi_i`, in the hemisphere of `sign`.
@@ -32,32 +35,23 @@ type Lobe<'a> = Box<dyn Fn(DVec3) -> f64 + Sync + 'a>;
 /// The specular part of the order-1 lobe of a facet material in colour channel `channel`
 /// (§5, with that channel's Fresnel): facets that reflect (and refract) like mirrors; `None`
 /// for diffuse facets.
-fn specular_part<'a, N: Ndf>(ndf: &'a N, material: &MaterialConfig, channel: usize, wi: DVec3) -> Option<Lobe<'a>> {
+fn specular_part<'a, N: Ndf>(ndf: &'a N, material: &Material<3>, channel: usize, wi: DVec3) -> Option<Lobe<'a>> {
     match *material {
-        MaterialConfig::Conductor { fresnel: kind, f0, eta, k, .. } => {
-            let f = move |c: f64| match kind {
-                FresnelKind::None => 1.0,
-                FresnelKind::Schlick => fresnel::schlick(f0.expect("validated").channel(channel), c),
-                FresnelKind::Exact => fresnel::conductor(
-                    eta.expect("validated").channel(channel),
-                    k.expect("validated").channel(channel),
-                    c,
-                ),
-            };
-            Some(Box::new(move |wo| single::reflection(ndf, wi, wo, f)))
+        Material::Conductor(Conductor { fresnel }) => {
+            Some(Box::new(move |wo| single::reflection(ndf, wi, wo, |c| fresnel.reflectance(channel, c))))
         }
-        MaterialConfig::Dielectric { eta, .. } => Some(Box::new(move |wo: DVec3| {
+        Material::Dielectric(Dielectric { eta }) => Some(Box::new(move |wo: DVec3| {
             if wo.z > 0.0 {
                 single::reflection(ndf, wi, wo, |c| fresnel::dielectric(eta, c))
             } else {
                 single::transmission(ndf, wi, wo, eta, |c| fresnel::dielectric(eta, c))
             }
         })),
-        MaterialConfig::Hammon { f0, .. } => {
-            let f0 = f0.channel(channel);
+        Material::Hammon(Hammon { f0, .. }) => {
+            let f0 = f0[channel];
             Some(Box::new(move |wo| single::reflection(ndf, wi, wo, |c| fresnel::schlick(f0, c))))
         }
-        MaterialConfig::Diffuse { .. } => None,
+        Material::Lambertian(_) => None,
     }
 }
 
@@ -67,18 +61,18 @@ fn specular_part<'a, N: Ndf>(ndf: &'a N, material: &MaterialConfig, channel: usi
 /// `visible()` builds; `None` for purely specular facets.
 fn diffuse_part<'a, N: Ndf>(
     ndf: &'a N,
-    material: &MaterialConfig,
+    material: &Material<3>,
     channel: usize,
     wi: DVec3,
     visible: impl FnOnce() -> Vec<(DVec3, f64)>,
 ) -> Option<Lobe<'a>> {
     match *material {
-        MaterialConfig::Diffuse { albedo, .. } => {
-            let (rho, visible) = (albedo.channel(channel), visible());
+        Material::Lambertian(Lambertian { albedo }) => {
+            let (rho, visible) = (albedo[channel], visible());
             Some(Box::new(move |wo| exit_lobe(ndf, wi, wo, &visible, |_, c| rho * c / PI)))
         }
-        MaterialConfig::Hammon { f0, albedo, .. } => {
-            let (f0, rho, visible) = (f0.channel(channel), albedo.channel(channel), visible());
+        Material::Hammon(Hammon { f0, albedo }) => {
+            let (f0, rho, visible) = (f0[channel], albedo[channel], visible());
             let k = 21.0 / (20.0 * PI);
             Some(Box::new(move |wo| {
                 exit_lobe(ndf, wi, wo, &visible, |ci, c| {
@@ -86,7 +80,7 @@ fn diffuse_part<'a, N: Ndf>(
                 })
             }))
         }
-        MaterialConfig::Conductor { .. } | MaterialConfig::Dielectric { .. } => None,
+        Material::Conductor(_) | Material::Dielectric(_) => None,
     }
 }
 
@@ -208,9 +202,9 @@ pub fn single_scattering_bins(
 /// Why single scattering is not available for `case` (the symmetric Smith Lambda, Hammon's
 /// normals, light from inside), or `None` where it is.
 pub fn single_scattering_unavailable(case: &Case) -> Option<&'static str> {
-    if case.smith != SmithKind::Exact {
+    if case.surface.smith != Smith::Exact {
         Some("symmetric Smith Lambda")
-    } else if case.normals != NormalsKind::Vndf {
+    } else if case.surface.normals != Normals::Visible {
         Some("Hammon's rejection normals")
     } else if case.side != IncidentSide::Outside {
         Some("light from inside")
@@ -231,10 +225,9 @@ pub fn single_scattering_lobe(
     if single_scattering_unavailable(case).is_some() {
         return None;
     }
-    let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
-    Some(match case.ndf {
-        NdfKind::Ggx => bins_for(&Ggx(roughness), case, grid, (hemisphere, channel), tolerance),
-        NdfKind::Beckmann => bins_for(&Beckmann(roughness), case, grid, (hemisphere, channel), tolerance),
+    Some(match case.surface.ndf {
+        AnyNdf::Ggx(ndf) => bins_for(&ndf, case, grid, (hemisphere, channel), tolerance),
+        AnyNdf::Beckmann(ndf) => bins_for(&ndf, case, grid, (hemisphere, channel), tolerance),
     })
 }
 
@@ -253,11 +246,10 @@ fn bins_for<N: Ndf>(
     if hemisphere == Hemisphere::T && !case.material.transmits() {
         return lobe;
     }
-    let wi = case.incident_direction();
-    let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
-    let visible = || match case.ndf {
-        NdfKind::Ggx => ggx_visible_rule(&Ggx(roughness), wi),
-        NdfKind::Beckmann => beckmann_visible_rule(&Beckmann(roughness), wi),
+    let wi = case.wi;
+    let visible = || match case.surface.ndf {
+        AnyNdf::Ggx(ndf) => ggx_visible_rule(&ndf, wi),
+        AnyNdf::Beckmann(ndf) => beckmann_visible_rule(&ndf, wi),
     };
     let parts: Vec<_> = [
         specular_part(ndf, &case.material, channel, wi)
@@ -290,7 +282,7 @@ fn bins_for<N: Ndf>(
 /// (`the_grading_scales_are_the_lobe_widths`).
 pub(crate) fn specular_peak(case: &Case, hemisphere: Hemisphere) -> Option<Peak> {
     let eta = match case.material {
-        MaterialConfig::Dielectric { eta, .. } => eta,
+        Material::Dielectric(Dielectric { eta }) => eta,
         _ => 1.0,
     };
     let (sin_i, cos_i) = case.theta_i_deg.to_radians().sin_cos();
@@ -300,7 +292,8 @@ pub(crate) fn specular_peak(case: &Case, hemisphere: Hemisphere) -> Option<Peak>
         Hemisphere::T => refract(wi, m, eta),
     };
     let cos_o = scatter(DVec3::Z)?.z.abs();
-    let (sin_t, cos_t) = (0.5 * case.alpha_x.min(case.alpha_y)).sin_cos();
+    let roughness = case.roughness();
+    let (sin_t, cos_t) = (0.5 * roughness.x.min(roughness.y)).sin_cos();
     let in_plane = scatter(DVec3::new(sin_t, 0.0, cos_t)).map_or(cos_o, |wo| (wo.z.abs() - cos_o).abs());
     let across = scatter(DVec3::new(0.0, sin_t, cos_t)).map_or(PI, |wo| wo.y.abs().atan2(-wo.x));
     Some(Peak { at: (cos_o, PI), scale: (in_plane, across) })
@@ -394,11 +387,12 @@ pub fn hammon_fit_bins(
 /// Why Hammon's fit does not apply to `case` (it was fitted to Hammon facets on isotropic GGX
 /// lit from outside), or `None` where it does.
 pub fn hammon_fit_unavailable(case: &Case) -> Option<&'static str> {
-    if !matches!(case.material, MaterialConfig::Hammon { .. }) {
+    let roughness = case.roughness();
+    if !matches!(case.material, Material::Hammon(_)) {
         Some("not a Hammon facet")
-    } else if case.ndf != NdfKind::Ggx {
+    } else if !matches!(case.surface.ndf, AnyNdf::Ggx(_)) {
         Some("not GGX")
-    } else if case.alpha_x != case.alpha_y {
+    } else if roughness.x != roughness.y {
         Some("anisotropic")
     } else if case.side != IncidentSide::Outside {
         Some("light from inside")
@@ -415,15 +409,14 @@ pub fn hammon_fit_lobe_bins(
     channel: usize,
     tolerance: &(dyn Fn(usize) -> f64 + Sync),
 ) -> Option<LobeIntegrals> {
-    let MaterialConfig::Hammon { f0, albedo, .. } = &case.material else { return None };
+    let Material::Hammon(Hammon { f0, albedo }) = case.material else { return None };
     if hammon_fit_unavailable(case).is_some() {
         return None;
     }
-    let (f0, albedo) = (f0.channel(channel), albedo.channel(channel));
-    let wi = case.incident_direction();
+    let (f0, albedo, wi) = (f0[channel], albedo[channel], case.wi);
     let peak = specular_peak(case, Hemisphere::R);
     Some(integrate_bins(case, grid, Hemisphere::R, (peak, tolerance, MAX_BIN_EVALUATIONS), |wo| {
-        hammon_fit_lobe(case.alpha_x, f0, albedo, wi, wo, part)
+        hammon_fit_lobe(case.roughness().x, f0, albedo, wi, wo, part)
     }))
 }
 
@@ -482,11 +475,11 @@ mod tests {
                                 "paths = 10\n[surface]\nndf = \"{ndf}\"\nalpha = {alpha}\n[material]\n{material}\n[incident]\ntheta_deg = {theta}\nphi_deg = 20\n"
                             ))
                             .unwrap(),
-                        )[0]
+                        )
+                        .unwrap()[0]
                         .clone();
-                        let (wi, phi_i) = (case.incident_direction(), case.phi_i_deg.to_radians());
+                        let (wi, phi_i) = (case.wi, case.phi_i_deg.to_radians());
                         let sin_i = theta.to_radians().sin();
-                        let roughness = Roughness { x: alpha, y: alpha };
                         for &h in hemispheres {
                             let beyond_critical = h == Hemisphere::T && eta.is_some_and(|eta| sin_i >= eta);
                             let Some(peak) = specular_peak(&case, h) else {
@@ -501,11 +494,9 @@ mod tests {
                                     half_width(|phi| lobe(direction(u, phi, phi_i, sign)), phi, (0.0, TAU)),
                                 )
                             };
-                            let (u, phi) = match case.ndf {
-                                NdfKind::Ggx => widths(specular_part(&Ggx(roughness), &case.material, 0, wi).unwrap()),
-                                NdfKind::Beckmann => {
-                                    widths(specular_part(&Beckmann(roughness), &case.material, 0, wi).unwrap())
-                                }
+                            let (u, phi) = match case.surface.ndf {
+                                AnyNdf::Ggx(ndf) => widths(specular_part(&ndf, &case.material, 0, wi).unwrap()),
+                                AnyNdf::Beckmann(ndf) => widths(specular_part(&ndf, &case.material, 0, wi).unwrap()),
                             };
                             for (axis, ratio) in [("cos", peak.scale.0 / u), ("phi", peak.scale.1 / phi)] {
                                 println!("{ndf} {alpha} {material:?} {theta} {h:?} {axis}: {ratio:.3}");

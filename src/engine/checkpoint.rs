@@ -108,7 +108,7 @@ pub fn load(dir: &Path, config: &Config, shard: Shard) -> Result<Option<Vec<Case
         "{}: the checkpoint belongs to another config, seed, path count or shard; remove it or run without --resume",
         path.display()
     );
-    let cases = expand(config);
+    let cases = expand(config)?;
     ensure!(file.states.len() == cases.len(), "{}: case count differs", path.display());
     let rounds = RunSettings { shard, ..RunSettings::from_config(config) }.rounds();
     for (i, s) in file.states.iter().enumerate() {

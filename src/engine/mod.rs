@@ -83,7 +83,7 @@ pub fn check_resources(config: &Config, threads: Option<usize>) -> Result<()> {
             "the run needs about {:.1} GB but {:.1} GB of memory are available: {} cases x {} x {} bins              (detector.cos_theta_bins x detector.phi_bins) x {slots} (detector.max_order) x {} channels,              held for every case and {threads} threads (--threads), plus lobes.csv; reduce the bins, set or              lower detector.max_order, sweep fewer cases or split the sweep into several configs",
             estimate as f64 / 1e9,
             available as f64 / 1e9,
-            crate::setup::cases::count(config),
+            config.cases(),
             d.cos_theta_bins,
             d.phi_bins,
             if config.is_rgb() { 3 } else { 1 }
@@ -107,7 +107,7 @@ pub fn memory_estimate(config: &Config, threads: usize) -> u64 {
     };
     let slots = d.max_order.map_or(ESTIMATED_SLOTS, |k| k as usize + 1) as u64;
     let bins = (d.cos_theta_bins * d.phi_bins) as u64;
-    let cases = crate::setup::cases::count(config);
+    let cases = config.cases();
     let detector = slots * 2 * bins * tally as u64;
     // Every case's state, and per thread the part of a round it walks and one waiting round.
     let held = (cases + 2 * threads as u64).saturating_mul(detector);
@@ -145,7 +145,7 @@ pub fn simulate_from(
     after_round: &mut RoundHook<'_>,
 ) -> Result<Simulation> {
     check_resources(config, options.threads)?;
-    let cases = crate::setup::cases::expand(config);
+    let cases = crate::setup::cases::expand(config)?;
     let settings =
         RunSettings { shard: options.shard, estimator: options.estimator, ..RunSettings::from_config(config) };
     // Joint chains carry one model per channel of an RGB detector.

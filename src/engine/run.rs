@@ -9,12 +9,11 @@ use std::sync::mpsc;
 
 use indicatif::ProgressBar;
 use microsurface::chain::{self, Escapes, Visibility};
-use microsurface::facet::{Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Lambertian};
-use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
+use microsurface::facet::Facet;
+use microsurface::material::Material;
+use microsurface::ndf::{AnyNdf, Beckmann, Ggx, Ndf};
 use microsurface::nee::NextEvent;
-use microsurface::normals::Normals;
 use microsurface::position_free::DepthProfile;
-use microsurface::smith::Smith;
 use microsurface::walk::{EnergyPolicy, Microsurface, Observer};
 use microsurface::wang::Shadowing;
 use rand_pcg::Pcg64Mcg;
@@ -22,7 +21,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::engine::detector::{Detector, Grid, Hemisphere};
 use crate::setup::cases::Case;
-use crate::setup::config::{Config, FresnelKind, MaterialConfig, NdfKind, NormalsKind, PrecisionConfig, SmithKind};
+use crate::setup::config::{Config, PrecisionConfig};
 
 /// Photons per chunk: the unit of work and of random streams. Part of the output's identity:
 /// changing it changes which random numbers each photon uses.
@@ -331,13 +330,13 @@ where
 {
     fn empty(&self) -> CaseResult {
         let w = &self.0;
-        Detector::<C>::new(w.settings.grid, w.case.incident_direction(), w.settings.max_order).into_result()
+        Detector::<C>::new(w.settings.grid, w.case.wi, w.settings.max_order).into_result()
     }
 
     fn walk_chunk(&self, chunk: u64, into: &mut CaseResult) {
         let w = &self.0;
         let detector = Detector::<C>::of_result(into);
-        let wi = w.case.incident_direction();
+        let wi = w.case.wi;
         let mut rng = chunk_rng(w.settings.seed, w.case.index, chunk);
         let policy = &w.settings.policy;
         let photons = w.settings.chunk_photons(chunk);
@@ -394,15 +393,19 @@ fn with_ndf<const C: usize, T>(case: &Case, settings: &RunSettings, f: impl FnOn
 where
     Detector<C>: DetectorResult,
 {
-    let roughness = Roughness { x: case.alpha_x, y: case.alpha_y };
-    match case.ndf {
-        NdfKind::Ggx => with_material::<Ggx, C, T>(Ggx(roughness), case, settings, f),
-        NdfKind::Beckmann => with_material::<Beckmann, C, T>(Beckmann(roughness), case, settings, f),
+    // Each NDF and facet is compiled into a walker of its own: the walk's hot loop then
+    // calls them without a dispatch.
+    let Microsurface { ndf, smith, normals } = case.surface;
+    match ndf {
+        AnyNdf::Ggx(ndf) => with_material::<Ggx, C, T>(Microsurface { ndf, smith, normals }, case, settings, f),
+        AnyNdf::Beckmann(ndf) => {
+            with_material::<Beckmann, C, T>(Microsurface { ndf, smith, normals }, case, settings, f)
+        }
     }
 }
 
 fn with_material<N: Ndf, const C: usize, T>(
-    ndf: N,
+    surface: Microsurface<N>,
     case: &Case,
     settings: &RunSettings,
     f: impl FnOnce(&dyn CaseWalker) -> T,
@@ -410,41 +413,13 @@ fn with_material<N: Ndf, const C: usize, T>(
 where
     Detector<C>: DetectorResult,
 {
-    let smith = match case.smith {
-        SmithKind::Exact => Smith::Exact,
-        SmithKind::Symmetric => Smith::Symmetric,
-    };
-    let normals = match case.normals {
-        NormalsKind::Vndf => Normals::Visible,
-        NormalsKind::HammonRejection => Normals::HammonRejection,
-    };
-    let surface = Microsurface { ndf, smith, normals };
     let channels = [(); C];
-    match &case.material {
-        MaterialConfig::Conductor { fresnel, f0, eta, k, .. } => {
-            let fresnel = match fresnel {
-                FresnelKind::None => ConductorFresnel::None,
-                FresnelKind::Schlick => ConductorFresnel::Schlick { f0: channels_of(f0) },
-                FresnelKind::Exact => ConductorFresnel::Exact { eta: channels_of(eta), k: channels_of(k) },
-            };
-            f(&(Walker { surface, facet: Conductor { fresnel }, case, settings }, channels))
-        }
-        MaterialConfig::Dielectric { eta, .. } => {
-            f(&(Walker { surface, facet: Dielectric { eta: *eta }, case, settings }, channels))
-        }
-        MaterialConfig::Diffuse { albedo, .. } => {
-            let facet = Lambertian { albedo: albedo.to_array() };
-            f(&(Walker { surface, facet, case, settings }, channels))
-        }
-        MaterialConfig::Hammon { f0, albedo, .. } => {
-            let facet = Hammon { f0: f0.to_array(), albedo: albedo.to_array() };
-            f(&(Walker { surface, facet, case, settings }, channels))
-        }
+    match case.material.channels::<C>() {
+        Material::Conductor(facet) => f(&(Walker { surface, facet, case, settings }, channels)),
+        Material::Dielectric(facet) => f(&(Walker { surface, facet, case, settings }, channels)),
+        Material::Lambertian(facet) => f(&(Walker { surface, facet, case, settings }, channels)),
+        Material::Hammon(facet) => f(&(Walker { surface, facet, case, settings }, channels)),
     }
-}
-
-fn channels_of<const C: usize>(c: &Option<crate::setup::config::Channels>) -> [f64; C] {
-    c.expect("validated: the Fresnel mode's parameters are present").to_array()
 }
 
 /// Chunks per round: the unit at which runs checkpoint and check precision targets. Rounds

@@ -36,7 +36,7 @@ impl CaseTallies {
     /// The result of `case` holding these tallies.
     pub(crate) fn into_result(self, case: &Case, config: &Config) -> CaseResult {
         let grid = Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins };
-        let wi = case.incident_direction();
+        let wi = case.wi;
         let max_order = config.detector.max_order;
         match self {
             CaseTallies::Mono(t) => {
@@ -185,7 +185,7 @@ fn merge_files(files: &[ShardFile], origins: &[String]) -> Result<(Config, Simul
         bail!("missing shards: {}{more} ({} of {count})", missing.join(", "), count - seen.len() as u64);
     }
     let config = Config::parse(&first.config_toml).context("the shards' config")?;
-    let cases = expand(&config);
+    let cases = expand(&config)?;
     for (file, origin) in files.iter().zip(origins) {
         ensure!(
             file.tallies.len() == cases.len(),
@@ -201,7 +201,7 @@ fn merge_files(files: &[ShardFile], origins: &[String]) -> Result<(Config, Simul
     let max_order = config.detector.max_order;
     let mut results = Vec::with_capacity(cases.len());
     for (i, case) in cases.iter().enumerate() {
-        let wi = case.incident_direction();
+        let wi = case.wi;
         let result = match &first.tallies[i] {
             CaseTallies::Mono(_) => {
                 CaseResult::Mono(Box::new(merged(grid, wi, max_order, files, i, CaseTallies::mono)?))

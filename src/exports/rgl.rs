@@ -36,12 +36,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 use glam::DVec3;
-use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
+use microsurface::ndf::Ndf;
 
 use crate::atomic::write_file_atomically;
 use crate::exports::sweep::Sweep;
 use crate::io::rundir::RunDir;
-use crate::setup::config::NdfKind;
 
 /// The grid points per axis of the u square unless `--resolution` says otherwise.
 pub const DEFAULT_RESOLUTION: usize = 64;
@@ -186,11 +185,7 @@ pub fn rgl_bytes(sweep: &Sweep, n: usize) -> Vec<u8> {
         rgb.extend(r);
         luminance.extend(l);
     }
-    let roughness = Roughness::isotropic(sweep.alpha);
-    let [ndf, sigma] = match sweep.ndf {
-        NdfKind::Ggx => surface_fields(&Ggx(roughness), n),
-        NdfKind::Beckmann => surface_fields(&Beckmann(roughness), n),
-    };
+    let [ndf, sigma] = surface_fields(&sweep.ndf, n);
     tensor_file(&[
         Field {
             name: "description",

@@ -9,13 +9,14 @@ use glam::DVec3;
 
 use crate::engine::detector::Grid;
 use crate::io::rundir::{BinValue, RunDir};
-use crate::setup::config::{IncidentSide, NdfKind};
+use microsurface::ndf::AnyNdf;
+
+use crate::setup::config::IncidentSide;
 
 /// The all-orders reflection lobes of an isotropic sweep over the incident angle.
 pub struct Sweep {
-    /// The surface's normal distribution and (isotropic) roughness.
-    pub ndf: NdfKind,
-    pub alpha: f64,
+    /// The surface's normal distribution with its (isotropic) roughness.
+    pub ndf: AnyNdf,
     /// One line naming the surface, the material and the incident angles.
     pub description: String,
     /// Incident polar angles (radians), ascending.
@@ -31,11 +32,7 @@ impl Sweep {
     pub fn read(run: &RunDir) -> Result<Self> {
         let first = run.cases.first().context("the run has no cases")?;
         for case in &run.cases {
-            let differs = case.ndf != first.ndf
-                || case.alpha_x != first.alpha_x
-                || case.smith != first.smith
-                || case.normals != first.normals
-                || case.material != first.material;
+            let differs = case.surface != first.surface || case.material != first.material;
             if differs {
                 bail!(
                     "{}: a measured-BRDF file holds one material, but the run sweeps the surface or \
@@ -44,11 +41,11 @@ impl Sweep {
                     case.index
                 );
             }
-            if case.alpha_x != case.alpha_y {
+            if case.roughness().x != case.roughness().y {
                 bail!(
                     "surface.alpha = [{}, {}] is not allowed: measured-BRDF exports are isotropic",
-                    case.alpha_x,
-                    case.alpha_y
+                    case.roughness().x,
+                    case.roughness().y
                 );
             }
             if case.side != IncidentSide::Outside {
@@ -75,17 +72,16 @@ impl Sweep {
             })
             .collect::<Result<Vec<_>>>()?;
         let description = format!(
-            "smithwalk: {:?} alpha {}, {}, all orders of reflection, theta_i {}..{} deg in {} steps",
-            first.ndf,
-            first.alpha_x,
-            first.material.label(),
+            "smithwalk: {} alpha {}, {}, all orders of reflection, theta_i {}..{} deg in {} steps",
+            first.surface.ndf.name(),
+            first.roughness().x,
+            first.material_label(),
             thetas[0].0.to_degrees(),
             thetas[thetas.len() - 1].0.to_degrees(),
             thetas.len()
         );
         Ok(Self {
-            ndf: first.ndf,
-            alpha: first.alpha_x,
+            ndf: first.surface.ndf,
             description,
             theta_i: thetas.iter().map(|t| t.0).collect(),
             lobes,

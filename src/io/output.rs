@@ -11,7 +11,11 @@ use crate::engine::Simulation;
 use crate::engine::detector::{Detector, Grid, Hemisphere, Moments, Tally};
 use crate::engine::run::CaseResult;
 use crate::setup::cases::Case;
-use crate::setup::config::{Config, IncidentSide, NormalsKind, SmithKind};
+use microsurface::ndf::Roughness;
+use microsurface::normals::Normals;
+use microsurface::smith::Smith;
+
+use crate::setup::config::{Config, HeightKind, IncidentSide, MaterialConfig};
 
 pub const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
 
@@ -30,13 +34,13 @@ pub(crate) const CASE_COLUMNS: [&str; 11] =
 pub(crate) fn case_fields(case: &Case) -> Vec<String> {
     vec![
         case.index.to_string(),
-        name(&case.ndf),
-        case.alpha_x.to_string(),
-        case.alpha_y.to_string(),
+        case.surface.ndf.name().to_string(),
+        case.roughness().x.to_string(),
+        case.roughness().y.to_string(),
         name(&case.height),
-        name(&case.smith),
-        name(&case.normals),
-        case.material.label(),
+        case.surface.smith.name().to_string(),
+        case.surface.normals.name().to_string(),
+        case.material_label(),
         case.theta_i_deg.to_string(),
         case.phi_i_deg.to_string(),
         name(&case.side),
@@ -165,8 +169,8 @@ Energy balance per case, in fractions of the incident energy (per order: summary
 /// only when some case departs from their defaults.
 pub fn balance_table(sim: &Simulation) -> String {
     let cases = &sim.cases;
-    let smith = cases.iter().any(|c| c.smith != SmithKind::Exact);
-    let normals = cases.iter().any(|c| c.normals != NormalsKind::Vndf);
+    let smith = cases.iter().any(|c| c.surface.smith != Smith::Exact);
+    let normals = cases.iter().any(|c| c.surface.normals != Normals::Visible);
     let side = cases.iter().any(|c| c.side != IncidentSide::Outside);
     let mut header = vec!["case", "ndf", "alpha"];
     header.extend(smith.then_some("smith"));
@@ -180,21 +184,18 @@ pub fn balance_table(sim: &Simulation) -> String {
     let mut rows: Vec<Vec<String>> = vec![header.iter().map(|h| h.to_string()).collect()];
     for (case, result) in cases.iter().zip(&sim.results) {
         let e = EnergyBalance::from_result(result);
-        let alpha = if case.alpha_x == case.alpha_y {
-            case.alpha_x.to_string()
-        } else {
-            format!("[{}, {}]", case.alpha_x, case.alpha_y)
-        };
+        let Roughness { x, y } = case.roughness();
+        let alpha = if x == y { x.to_string() } else { format!("[{x}, {y}]") };
         let folded = match result {
             CaseResult::Mono(d) => d.is_folded(e.highest_order),
             CaseResult::Rgb(d) => d.is_folded(e.highest_order),
         };
         let orders = format!("{}{}", e.highest_order, if folded { "+" } else { "" });
         for (c, channel) in CHANNEL_NAMES.iter().enumerate().take(e.reflected.len()) {
-            let mut row = vec![case.index.to_string(), name(&case.ndf), alpha.clone()];
-            row.extend(smith.then(|| name(&case.smith)));
-            row.extend(normals.then(|| name(&case.normals)));
-            row.push(case.material.label());
+            let mut row = vec![case.index.to_string(), case.surface.ndf.name().to_string(), alpha.clone()];
+            row.extend(smith.then(|| case.surface.smith.name().to_string()));
+            row.extend(normals.then(|| case.surface.normals.name().to_string()));
+            row.push(case.material_label());
             row.extend(side.then(|| name(&case.side)));
             row.extend(sim.rgb.then(|| channel.to_string()));
             row.push(format!("{:.2}", case.theta_i_deg));
@@ -368,11 +369,41 @@ pub fn summary_csv(sim: &Simulation) -> Result<Vec<u8>> {
     Ok(w.into_inner()?)
 }
 
+/// A case in `run.json`: its parameters as the configuration spells them, and its energy.
 #[derive(Serialize)]
 struct CaseReport<'a> {
-    #[serde(flatten)]
-    case: &'a Case,
+    index: usize,
+    ndf: &'static str,
+    alpha_x: f64,
+    alpha_y: f64,
+    height: HeightKind,
+    smith: &'static str,
+    normals: &'static str,
+    material: &'a MaterialConfig,
+    theta_i_deg: f64,
+    phi_i_deg: f64,
+    side: IncidentSide,
     energy: EnergyBalance,
+}
+
+impl<'a> CaseReport<'a> {
+    fn new(case: &'a Case, energy: EnergyBalance) -> Self {
+        let Roughness { x, y } = case.roughness();
+        CaseReport {
+            index: case.index,
+            ndf: case.surface.ndf.name(),
+            alpha_x: x,
+            alpha_y: y,
+            height: case.height,
+            smith: case.surface.smith.name(),
+            normals: case.surface.normals.name(),
+            material: &case.material_spec,
+            theta_i_deg: case.theta_i_deg,
+            phi_i_deg: case.phi_i_deg,
+            side: case.side,
+            energy,
+        }
+    }
 }
 
 /// A file of the run as `run.json` records it, so that readers can tell it is the one this run
@@ -461,7 +492,7 @@ pub fn run_json(sim: &Simulation, config: &Config, tables: [&[u8]; 2]) -> Result
             .cases
             .iter()
             .zip(&sim.results)
-            .map(|(case, r)| CaseReport { case, energy: EnergyBalance::from_result(r) })
+            .map(|(case, r)| CaseReport::new(case, EnergyBalance::from_result(r)))
             .collect(),
         self_sha256: "0".repeat(64),
     };

@@ -530,7 +530,7 @@ impl RunDir {
         let lock = lock_dir(path, false)?;
         let run = read_run_json(path)?;
         let config = run.config;
-        let cases = crate::setup::cases::expand(&config);
+        let cases = crate::setup::cases::expand(&config)?;
         if run.cases.len() != cases.len() {
             bail!(
                 "{}: {} cases recorded, the config has {}",

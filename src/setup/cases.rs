@@ -1,88 +1,89 @@
-//! Expansion of a configuration into cases: the cartesian product of every sweep.
+//! Expansion of a configuration into cases: the cartesian product of every sweep, each case
+//! carrying the physics values of [`crate::setup::config::physics`].
 
 use glam::DVec3;
 use itertools::iproduct;
-use serde::Serialize;
+use microsurface::material::Material;
+use microsurface::ndf::{AnyNdf, Ndf, Roughness};
+use microsurface::normals::Normals;
+use microsurface::smith::Smith;
+use microsurface::walk::Microsurface;
 
-use crate::setup::config::{Config, HeightKind, IncidentSide, MaterialConfig, NdfKind, NormalsKind, SmithKind};
+use crate::setup::config::physics;
+use crate::setup::config::{Config, ConfigError, HeightKind, IncidentSide, MaterialConfig};
 
-/// One measurement: a surface, a facet material and an incident direction.
-#[derive(Clone, Debug, Serialize, PartialEq)]
+/// One measurement: a surface, a facet material and an incident direction, as physics values.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Case {
     pub index: usize,
-    pub ndf: NdfKind,
-    pub alpha_x: f64,
-    pub alpha_y: f64,
+    /// The NDF with its roughness, the Lambda of the height process and the law of hit normals.
+    pub surface: Microsurface<AnyNdf>,
+    /// The height distribution, for the tables: the walk runs in optical depth, on which no
+    /// height law has any effect (§2.1).
     pub height: HeightKind,
-    pub smith: SmithKind,
-    pub normals: NormalsKind,
-    pub material: MaterialConfig,
+    /// The facets' micro-BSDF in three channels (a one-value parameter in all three).
+    pub material: Material<3>,
+    /// The `[material]` table as the configuration gave it, for reports and labels (the
+    /// physics reads [`Case::material`]).
+    pub material_spec: MaterialConfig,
     pub theta_i_deg: f64,
     pub phi_i_deg: f64,
     pub side: IncidentSide,
+    /// The direction towards the light (§0).
+    pub wi: DVec3,
 }
 
 impl Case {
-    /// The direction towards the light (§0): above the horizon from outside, below from inside.
-    pub fn incident_direction(&self) -> DVec3 {
-        let (st, ct) = self.theta_i_deg.to_radians().sin_cos();
-        let (sp, cp) = self.phi_i_deg.to_radians().sin_cos();
-        let z = match self.side {
-            IncidentSide::Outside => ct,
-            IncidentSide::Inside => -ct,
-        };
-        DVec3::new(st * cp, st * sp, z)
+    /// The material's label for tables: the user's `name`, or the kind and its parameters.
+    pub fn material_label(&self) -> String {
+        self.material_spec.label()
+    }
+
+    /// The roughness (alpha_x, alpha_y) of the NDF.
+    pub fn roughness(&self) -> Roughness {
+        self.surface.ndf.roughness()
     }
 
     /// Whether the exact position-free form (docs/theory.md §7.1) describes this case's walk: facets
     /// that reflect on one side, the true Smith Lambda and visible normals (the chain's laws).
     pub fn position_free_applies(&self) -> bool {
-        !self.material.transmits() && self.smith == SmithKind::Exact && self.normals == NormalsKind::Vndf
+        !self.material.transmits() && self.surface.smith == Smith::Exact && self.surface.normals == Normals::Visible
     }
 }
 
-/// The number of cases of a configuration, without expanding it (saturating: a validated
-/// config has at most [`crate::setup::config::MAX_CASES`]).
-pub fn count(config: &Config) -> u64 {
-    let s = &config.surface;
-    let i = &config.incident;
-    let thetas = i.theta_deg.as_ref().or(i.theta_rad.as_ref()).map_or(0, |t| t.as_slice().len());
-    [
-        s.ndf.as_slice().len(),
-        s.alpha.as_slice().len(),
-        s.height.as_slice().len(),
-        s.smith.as_slice().len(),
-        s.normals.as_slice().len(),
-        config.material.as_slice().len(),
-        i.side.as_slice().len(),
-        thetas,
-        i.phi_deg.as_slice().len(),
-    ]
-    .into_iter()
-    .fold(1u64, |n, len| n.saturating_mul(len as u64))
-}
-
 /// The cases of a configuration, in the order ndf, alpha, height, smith, normals, material,
-/// side, theta, phi (the last varies fastest). The index of a case is its position.
-pub fn expand(config: &Config) -> Vec<Case> {
+/// side, theta, phi (the last varies fastest). The index of a case is its position. Each
+/// value is checked as it is converted, so a configuration that was not validated gives the
+/// error that [`Config::validate`] would.
+pub fn expand(config: &Config) -> Result<Vec<Case>, ConfigError> {
     let s = &config.surface;
     let i = &config.incident;
+    let roughnesses = s.alpha.values().into_iter().map(physics::roughness).collect::<Result<Vec<_>, _>>()?;
+    let materials = config
+        .material_fields()
+        .map(|(field, m)| Ok((physics::material(&field, m)?, m.clone())))
+        .collect::<Result<Vec<_>, ConfigError>>()?;
     let product = iproduct!(
         s.ndf.values(),
-        s.alpha.values(),
+        roughnesses,
         s.height.values(),
         s.smith.values(),
         s.normals.values(),
-        config.material.values(),
+        materials,
         i.side.values(),
         i.theta_degrees(),
         i.phi_deg.values()
     );
-    product
-        .enumerate()
-        .map(|(index, (ndf, alpha, height, smith, normals, material, side, theta_i_deg, phi_i_deg))| {
-            let (alpha_x, alpha_y) = alpha.xy();
-            Case { index, ndf, alpha_x, alpha_y, height, smith, normals, material, theta_i_deg, phi_i_deg, side }
-        })
-        .collect()
+    let cases = product.enumerate().map(
+        |(index, (ndf, roughness, height, smith, normals, (material, material_spec), side, theta_i_deg, phi_i_deg))| {
+            let surface = Microsurface {
+                ndf: physics::ndf(ndf, roughness),
+                smith: physics::smith(smith),
+                normals: physics::normals(normals),
+            };
+            let wi = physics::incident_direction(theta_i_deg, phi_i_deg, side);
+            Case { index, surface, height, material, material_spec, theta_i_deg, phi_i_deg, side, wi }
+        },
+    );
+    Ok(cases.collect())
 }

@@ -18,11 +18,14 @@ use crate::roots::newton_bisect;
 /// for dielectrics).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Side {
+    /// Above the heightfield, where light arrives from (the `+z` side).
     Outside,
+    /// Below the heightfield, inside a dielectric.
     Inside,
 }
 
 impl Side {
+    /// The side across the interface.
     pub fn other(self) -> Self {
         match self {
             Side::Outside => Side::Inside,
@@ -122,9 +125,17 @@ pub enum ConductorFresnel<const C: usize> {
     /// `F = 1`: the white furnace.
     None,
     /// Schlick's approximation from normal-incidence reflectance F0.
-    Schlick { f0: [f64; C] },
+    Schlick {
+        /// Reflectance at normal incidence, per channel.
+        f0: [f64; C],
+    },
     /// Exact Fresnel of the complex relative index `eta + i k`.
-    Exact { eta: [f64; C], k: [f64; C] },
+    Exact {
+        /// Real part of the relative index, per channel.
+        eta: [f64; C],
+        /// Extinction coefficient, per channel.
+        k: [f64; C],
+    },
 }
 
 impl<const C: usize> ConductorFresnel<C> {
@@ -152,6 +163,7 @@ impl<const C: usize> ConductorFresnel<C> {
 /// Mirror facets that reflect `F` and absorb the rest (§4.2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Conductor<const C: usize> {
+    /// The facets' Fresnel law.
     pub fresnel: ConductorFresnel<C>,
 }
 
@@ -185,6 +197,7 @@ impl<const C: usize> Facet<C> for Conductor<C> {
 /// with the exact Fresnel probability, refract otherwise; no absorption.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Dielectric {
+    /// The relative index `n_inside / n_outside`, every channel.
     pub eta: f64,
 }
 
@@ -246,6 +259,7 @@ impl<const C: usize> Facet<C> for Dielectric {
 /// Lambertian facets of albedo `rho` (§4.4): cosine-distributed exit about `m`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lambertian<const C: usize> {
+    /// The facets' albedo, per channel.
     pub albedo: [f64; C],
 }
 
@@ -282,7 +296,9 @@ impl<const C: usize> Facet<C> for Lambertian<C> {
 /// Fresnel-weighted diffuse exit with density `k (1 - (1 - c)^5) c`, `k = 21 / (20 pi)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hammon<const C: usize> {
+    /// Reflectance of the specular coat at normal incidence (Schlick), per channel.
     pub f0: [f64; C],
+    /// Albedo of the diffuse base, per channel.
     pub albedo: [f64; C],
 }
 

@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! The statistical Smith microsurface as a random medium.
 //!
 //! A microsurface is composed of independent pieces, each behind a trait where real
@@ -25,6 +26,28 @@
 //! * [`random`], [`roots`]: variates and the root finder behind the inverse-CDF samplers.
 //!
 //! Everything here is pure physics: no I/O, no threads, no binning.
+//!
+//! # Public API
+//!
+//! This crate is what the `smithwalk` command line, its Python package and outside Rust code
+//! link against. Its public API is every public item documented here; the items outside Rust
+//! users are meant to build on are:
+//!
+//! * the surface: [`ndf::Ndf`] (the trait every NDF implements), [`ndf::Ggx`],
+//!   [`ndf::Beckmann`], [`ndf::Roughness`], and [`ndf::AnyNdf`] (an NDF chosen at run time);
+//!   [`smith::Smith`], [`normals::Normals`], and [`walk::Microsurface`], which composes them;
+//! * the facets: [`facet::Facet`] (the trait every micro-BSDF implements), [`facet::Conductor`]
+//!   with its [`facet::ConductorFresnel`], [`facet::Dielectric`], [`facet::Lambertian`],
+//!   [`facet::Hammon`], and [`material::Material`] (a material chosen at run time);
+//! * the walk: [`walk::Microsurface::trace`] with an [`walk::Observer`] and an
+//!   [`walk::EnergyPolicy`];
+//! * the oracles: [`single`] (exact single scattering), [`nee`] (next-event estimation),
+//!   [`position_free`], [`wang`].
+//!
+//! Directions are [`DVec3`] (glam's, re-exported), pointing away from the surface (§0); a
+//! `const C: usize` parameter is the number of colour channels (1 or 3). The version policy
+//! (semantic versioning; while at 0.x, a minor version may break the API, a patch never does)
+//! is in the repository's CHANGELOG.md.
 
 pub mod beta;
 pub mod chain;

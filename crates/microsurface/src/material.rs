@@ -10,7 +10,7 @@
 use glam::DVec3;
 use rand::Rng;
 
-use crate::facet::{Conductor, Dielectric, Facet, Hammon, Interaction, Lambertian, Side};
+use crate::facet::{Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Interaction, Lambertian, Side};
 use crate::ndf::Ndf;
 
 /// The micro-BSDF of every facet, with `C` colour channels (1 or 3).
@@ -48,6 +48,28 @@ impl<const C: usize> Material<C> {
         match self {
             Material::Conductor(conductor) => Some(conductor.fresnel.reflectance(channel, c)),
             _ => None,
+        }
+    }
+}
+
+impl Material<3> {
+    /// The material in its first `C` channels (`C` is 1 or 3): a walk of one channel takes the
+    /// first of a material whose parameters are the same in every channel.
+    pub fn channels<const C: usize>(&self) -> Material<C> {
+        let first = |v: [f64; 3]| -> [f64; C] { std::array::from_fn(|i| v[i]) };
+        match *self {
+            Material::Conductor(Conductor { fresnel }) => Material::Conductor(Conductor {
+                fresnel: match fresnel {
+                    ConductorFresnel::None => ConductorFresnel::None,
+                    ConductorFresnel::Schlick { f0 } => ConductorFresnel::Schlick { f0: first(f0) },
+                    ConductorFresnel::Exact { eta, k } => ConductorFresnel::Exact { eta: first(eta), k: first(k) },
+                },
+            }),
+            Material::Dielectric(d) => Material::Dielectric(d),
+            Material::Lambertian(Lambertian { albedo }) => Material::Lambertian(Lambertian { albedo: first(albedo) }),
+            Material::Hammon(Hammon { f0, albedo }) => {
+                Material::Hammon(Hammon { f0: first(f0), albedo: first(albedo) })
+            }
         }
     }
 }

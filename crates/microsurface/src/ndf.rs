@@ -18,11 +18,14 @@ const SQRT_PI: f64 = 1.772_453_850_905_516;
 /// Anisotropic roughness: the slope scales along the tangent axes x and y (§0, §1.2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Roughness {
+    /// Roughness along the tangent axis x.
     pub x: f64,
+    /// Roughness along the tangent axis y.
     pub y: f64,
 }
 
 impl Roughness {
+    /// The same roughness `alpha` along both axes.
     pub fn isotropic(alpha: f64) -> Self {
         Self { x: alpha, y: alpha }
     }
@@ -51,6 +54,7 @@ impl Roughness {
 
 /// A microfacet normal distribution (§1.2): the alternatives are GGX and Beckmann.
 pub trait Ndf: Copy + Send + Sync {
+    /// The roughness (alpha_x, alpha_y) that stretches the roughness-1 configuration (§1.1).
     fn roughness(&self) -> Roughness;
 
     /// The distribution of normals D(m) [sr^-1] for `m_z > 0` (§1.2), zero below.
@@ -261,7 +265,9 @@ impl Ndf for Beckmann {
 /// variant here, and the compiler lists every `match` to extend.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum AnyNdf {
+    /// GGX (Trowbridge–Reitz).
     Ggx(Ggx),
+    /// Beckmann.
     Beckmann(Beckmann),
 }
 

@@ -62,12 +62,17 @@ where
 /// but with effectively infinite variance.) Escapes of the walk itself are ignored; losses
 /// are passed on.
 pub struct NextEvent<'a, N, F, O, R> {
+    /// The microsurface's NDF.
     pub ndf: &'a N,
+    /// The law of the hit normals, for the phase function's directions.
     pub normals: Normals,
+    /// The facets' micro-BSDF.
     pub facet: &'a F,
+    /// Where the deposits go, at the hit's order.
     pub sink: &'a mut O,
     /// The estimator's own random stream, kept across photons.
     pub rng: &'a mut R,
+    /// Outgoing directions drawn per hit.
     pub samples: u32,
 }
 

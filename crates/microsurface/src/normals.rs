@@ -21,6 +21,14 @@ pub enum Normals {
 }
 
 impl Normals {
+    /// The law's name as configurations spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Normals::Visible => "vndf",
+            Normals::HammonRejection => "hammon-rejection",
+        }
+    }
+
     /// Draws the normal of the facet hit by a ray travelling along `d`.
     #[inline]
     pub fn sample<N: Ndf, R: Rng + ?Sized>(self, ndf: &N, d: DVec3, rng: &mut R) -> DVec3 {

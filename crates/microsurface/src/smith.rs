@@ -17,6 +17,14 @@ pub enum Smith {
 }
 
 impl Smith {
+    /// The variant's name as configurations spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Smith::Exact => "exact",
+            Smith::Symmetric => "symmetric",
+        }
+    }
+
     /// Extinction rate in optical depth of a ray travelling along `d` (§2.4):
     /// `lambda(d) = Lambda(d)` upward and `1 + Lambda(-d)` downward (true Smith), or
     /// `Lambda(-d)` downward with Hammon's variant (§2.7). `+inf` for horizontal travel.

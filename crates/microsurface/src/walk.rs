@@ -21,10 +21,13 @@ use crate::smith::Smith;
 /// A microsurface: an NDF, the Smith variant driving the free flights and the law of the hit
 /// normals. Facet materials plug in independently. (The height distribution does not appear:
 /// the walk runs in optical depth, on which no height law has any effect, §2.1.)
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Microsurface<N> {
+    /// The distribution of normals with its roughness.
     pub ndf: N,
+    /// The Lambda that drives the free flights.
     pub smith: Smith,
+    /// The law of the normals a ray hits.
     pub normals: Normals,
 }
 

@@ -29,7 +29,7 @@ impl Sweep {
     fn x(self, case: &Case) -> f64 {
         match self {
             Sweep::Theta => case.theta_i_deg,
-            Sweep::Alpha => case.alpha_x,
+            Sweep::Alpha => case.roughness().x,
         }
     }
 
@@ -43,7 +43,7 @@ impl Sweep {
 
     /// Whether the case belongs on this figure: the roughness sweep takes isotropic surfaces.
     fn takes(self, case: &Case) -> bool {
-        self == Sweep::Theta || case.alpha_x == case.alpha_y
+        self == Sweep::Theta || case.roughness().x == case.roughness().y
     }
 
     fn axis(self) -> &'static str {

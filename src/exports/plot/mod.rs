@@ -244,7 +244,7 @@ fn groups<'a>(cases: impl IntoIterator<Item = &'a Case>, swept: &[usize]) -> Vec
     let mut out: Vec<Vec<&Case>> = map.into_values().collect();
     out.sort_by_key(|cases| cases[0].index);
     for cases in &mut out {
-        cases.sort_by(|a, b| a.theta_i_deg.total_cmp(&b.theta_i_deg).then(a.alpha_x.total_cmp(&b.alpha_x)));
+        cases.sort_by(|a, b| a.theta_i_deg.total_cmp(&b.theta_i_deg).then(a.roughness().x.total_cmp(&b.roughness().x)));
     }
     out
 }
@@ -289,10 +289,10 @@ fn describe(fields: &[String], columns: &[usize]) -> Vec<String> {
 /// Smith and normals settings when they are not the defaults) and the side the light comes
 /// from, named when it is not outside or when the run has both sides.
 fn surface_label(run: &RunDir, case: &Case) -> String {
-    let alpha = if case.alpha_x == case.alpha_y {
-        format!("α = {}", case.alpha_x)
+    let alpha = if case.roughness().x == case.roughness().y {
+        format!("α = {}", case.roughness().x)
     } else {
-        format!("α = ({}, {})", case.alpha_x, case.alpha_y)
+        format!("α = ({}, {})", case.roughness().x, case.roughness().y)
     };
     let fields = case_fields(case);
     let mut label = format!("{}, {alpha}, {}", fields[1].to_uppercase(), fields[7]);

@@ -1,0 +1,71 @@
+//! The `[compare]` table: the models `smithwalk compare` judges the run against.
+
+use serde::{Deserialize, Serialize};
+
+/// The analytic models `smithwalk compare` can judge a run against (`crate::analysis::compare`
+/// evaluates them; the configuration only names them).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Model {
+    Single,
+    HammonFit,
+    HeitzNee,
+    WangCorrelated,
+    WangUncorrelated,
+    ExactPositionFree,
+    /// Energy compensation of Kulla & Conty 2017, all orders (`analysis::compensation`).
+    KullaConty,
+    /// Energy compensation of Turquin 2019, all orders.
+    Turquin,
+    /// Energy compensation of Fdez-Agüera 2019, all orders.
+    FdezAguera,
+    /// A user's own model read from a file (`smithwalk compare --external`); not in [`Model::ALL`].
+    External,
+}
+
+impl Model {
+    pub const ALL: [Model; 9] = [
+        Model::Single,
+        Model::HammonFit,
+        Model::HeitzNee,
+        Model::WangCorrelated,
+        Model::WangUncorrelated,
+        Model::ExactPositionFree,
+        Model::KullaConty,
+        Model::Turquin,
+        Model::FdezAguera,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Model::Single => "single",
+            Model::HammonFit => "hammon-fit",
+            Model::HeitzNee => "heitz-nee",
+            Model::WangCorrelated => "wang-correlated",
+            Model::WangUncorrelated => "wang-uncorrelated",
+            Model::ExactPositionFree => "exact-position-free",
+            Model::KullaConty => "kulla-conty",
+            Model::Turquin => "turquin",
+            Model::FdezAguera => "fdez-aguera",
+            Model::External => "external",
+        }
+    }
+
+    pub fn parse(text: &str) -> Result<Self, String> {
+        Model::ALL.into_iter().find(|m| m.name() == text).ok_or_else(|| {
+            let names: Vec<&str> = Model::ALL.iter().map(|m| m.name()).collect();
+            format!("{text:?} is not a model; allowed: {}", names.join(", "))
+        })
+    }
+}
+
+/// Models to compare the run with when it finishes (`smithwalk compare` on its output).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CompareConfig {
+    /// Model names: `single`, `hammon-fit`, `heitz-nee`, `exact-position-free`, `wang-correlated`,
+    /// `wang-uncorrelated`, `kulla-conty`, `turquin`, `fdez-aguera`.
+    pub models: Vec<String>,
+    /// Photons per case for the Monte Carlo models (default: the run's `paths`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub paths: Option<u64>,
+}
