@@ -21,8 +21,6 @@
 //!   the sample square) against the run's (within 1%), and at 42 deg, between two nodes,
 //!   against the run's albedos at 40 and 44 deg averaged (within 1%).
 
-use crate::common;
-
 use std::collections::HashMap;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::io::Write;

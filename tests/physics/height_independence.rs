@@ -9,8 +9,6 @@
 //! height_walk.rs against a reference walk that samples actual heights. (The height process
 //! itself is tested against its closed forms in height_process.rs.)
 
-use crate::common;
-
 use smithwalk::setup::config::Config;
 
 fn csv_without_height(height: &str, file: &str) -> String {

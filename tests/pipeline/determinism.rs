@@ -2,8 +2,6 @@
 //! command line's handling of bad input: one clear error naming the field, the value and what
 //! is allowed, a non-zero exit, and no output file.
 
-use crate::common;
-
 use std::path::Path;
 use std::process::Command;
 

@@ -4,8 +4,6 @@
 //! that a run is writing; a run removes the leftovers of a killed run and the previous run's
 //! derived files, and refuses a directory in use.
 
-use crate::common;
-
 use std::path::Path;
 use std::process::Command;
 
