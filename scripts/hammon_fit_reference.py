@@ -2,7 +2,7 @@
 """Hammon 2017's closed-form fit evaluated from the slides alone ("GGX Diffuse Approximation"
 and "Smith: Approximate GGX G2"; shared/seeds/hammon2017-pbr-diffuse-ggx-smith.txt, lines
 905-909 and 1230-1235), independently of smithwalk's code: the reference values of
-tests/hammon_fit.rs.
+tests/physics/hammon_fit.rs.
 
 The printed value is the cosine-weighted lobe (specular + diffuse) * N.V for light towards L
 and the detector towards V, isotropic GGX alpha (D(H) = alpha^2 / (pi ((N.H)^2 (alpha^2 - 1) +

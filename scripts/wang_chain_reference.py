@@ -3,7 +3,7 @@
 conductor (F = 1), written from the formulas, sharing no code with smithwalk. Own-side frame:
 inside directions are point-reflected (-v).
 
-It gives the reference values of tests/wang_models.rs (`the_correlated_central_spike_is_the_models`):
+It gives the reference values of tests/physics/wang_models.rs (`the_correlated_central_spike_is_the_models`):
 the energy of the innermost cos ring (|cos theta| in [31/32, 1]) of the transmitted orders 3 and
 4+, dielectric eta 1.5, GGX alpha 0.5, theta_i 0.5 rad, as the mean and standard error over 10
 seeds of 4*10^5 chains each:

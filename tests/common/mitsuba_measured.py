@@ -1,4 +1,4 @@
-"""Loads an RGL .bsdf file in Mitsuba 3's `measured` plugin (scalar_rgb) and answers tests/rgl.rs.
+"""Loads an RGL .bsdf file in Mitsuba 3's `measured` plugin (scalar_rgb) and answers tests/exports/rgl.rs.
 
 Reads JSON from stdin: {"file": PATH, "eval": [[wix, wiy, wiz, wox, woy, woz], ...],
 "albedo": [[theta_i_rad, n], ...]}. Writes JSON to stdout: {"eval": [[r, g, b], ...] (Mitsuba's

@@ -1,0 +1,12 @@
+//! `smithwalk compare` and the models it judges: verdicts end to end, `models.csv`, the
+//! energy-compensation models and the albedo tables they read. One test binary (each file a
+//! module) so that the crate is linked once.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod albedo_table;
+mod compare;
+mod compare_verdicts;
+mod compensation;
+mod models_table;
