@@ -88,17 +88,86 @@ pub trait Facet<const C: usize>: Send + Sync {
         crosses: bool,
         rng: &mut R,
     ) -> [f64; C];
+
+    /// The material's relative index `eta = n_inside / n_outside` if light can cross to the
+    /// other side of the surface (only smooth dielectric facets refract); `None` otherwise.
+    fn refraction_eta(&self) -> Option<f64> {
+        None
+    }
+
+    /// The share of the facet's scattering that leaves in the mirror direction, in [0, 1]: the
+    /// weight of the specular lobe in an importance density (a renderer's MIS density,
+    /// [`crate::bsdf`]). A heuristic for efficiency only; 0, the default, means diffuse.
+    fn mirror_share(&self) -> f64 {
+        0.0
+    }
+
+    /// Checks the facet's parameters: an error names the first one out of range.
+    fn check(&self) -> Result<(), ParameterError> {
+        Ok(())
+    }
 }
+
+/// A parameter out of its allowed range: which one, its value and what is allowed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParameterError {
+    pub field: &'static str,
+    pub value: f64,
+    pub allowed: &'static str,
+}
+
+impl std::fmt::Display for ParameterError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} = {} is out of range: allowed is {}", self.field, self.value, self.allowed)
+    }
+}
+
+impl std::error::Error for ParameterError {}
+
+/// Checks that every channel of `values` lies in `range` (NaN never does).
+pub(crate) fn check_range<const C: usize>(
+    field: &'static str,
+    values: &[f64; C],
+    range: impl std::ops::RangeBounds<f64>,
+    allowed: &'static str,
+) -> Result<(), ParameterError> {
+    match values.iter().find(|v| !range.contains(v)) {
+        Some(&value) => Err(ParameterError { field, value, allowed }),
+        None => Ok(()),
+    }
+}
+
+/// Finite and positive (`(0, inf)`).
+const POSITIVE: (std::ops::Bound<f64>, std::ops::Bound<f64>) =
+    (std::ops::Bound::Excluded(0.0), std::ops::Bound::Included(f64::MAX));
 
 /// `D(h) / (4 A(w))`: the density of mirror-reflected directions `w -> d` (§3.1), 0 when the
 /// half vector faces away; returns it with the cosine `w·h` for the Fresnel factor.
-fn mirror_density<N: Ndf>(ndf: &N, w: DVec3, d: DVec3) -> Option<(f64, f64)> {
+pub(crate) fn mirror_density<N: Ndf>(ndf: &N, w: DVec3, d: DVec3) -> Option<(f64, f64)> {
     let h = (w + d).normalize();
     let c = w.dot(h);
     if !(h.z > 0.0 && c > 0.0) {
         return None;
     }
     Some((ndf.d(h) / (4.0 * ndf.projected_area(w)), c))
+}
+
+/// `D_w(h) eta^2 |d·h| / (w·h + eta d·h)^2`: the density of directions `w -> d` refracted
+/// by visible normals with relative index `eta` (§4.3), 0 when no facet refracts `w` into
+/// `d`; returns it with the cosine `w·h` for the Fresnel factor.
+pub(crate) fn refraction_density<N: Ndf>(ndf: &N, w: DVec3, d: DVec3, eta: f64) -> Option<(f64, f64)> {
+    // h ∝ -(w + eta d), oriented up; needs w·h > 0 > d·h.
+    let mut h = -(w + eta * d).normalize();
+    if h.z < 0.0 {
+        h = -h;
+    }
+    let (ci, co) = (w.dot(h), d.dot(h));
+    if !(h.z > 0.0 && ci > 0.0 && co < 0.0) {
+        return None;
+    }
+    let visible = ci * ndf.d(h) / ndf.projected_area(w);
+    let denom = ci + eta * co;
+    Some((visible * eta * eta * -co / (denom * denom), ci))
 }
 
 /// Mirror reflection of `w` about `m`: `2 (w·m) m - w`.
@@ -191,6 +260,21 @@ impl<const C: usize> Facet<C> for Conductor<C> {
             _ => [0.0; C],
         }
     }
+
+    fn mirror_share(&self) -> f64 {
+        1.0
+    }
+
+    fn check(&self) -> Result<(), ParameterError> {
+        match self.fresnel {
+            ConductorFresnel::None => Ok(()),
+            ConductorFresnel::Schlick { f0 } => check_range("f0", &f0, 0.0..=1.0, "a number in [0, 1]"),
+            ConductorFresnel::Exact { eta, k } => {
+                check_range("eta", &eta, POSITIVE, "a finite number > 0")?;
+                check_range("k", &k, 0.0..=f64::MAX, "a finite number >= 0")
+            }
+        }
+    }
 }
 
 /// Smooth dielectric facets of relative index `eta = n_inside / n_outside` (§4.3): reflect
@@ -241,18 +325,22 @@ impl<const C: usize> Facet<C> for Dielectric {
                 None => [0.0; C],
             };
         }
-        // Refraction (§4.3): h ∝ -(w + eta d), oriented up; needs w·h > 0 > d·h.
-        let mut h = -(w + eta * d).normalize();
-        if h.z < 0.0 {
-            h = -h;
+        match refraction_density(ndf, w, d, eta) {
+            Some((density, c)) => [(1.0 - fresnel::dielectric(eta, c)) * density; C],
+            None => [0.0; C],
         }
-        let (ci, co) = (w.dot(h), d.dot(h));
-        if !(h.z > 0.0 && ci > 0.0 && co < 0.0) {
-            return [0.0; C];
-        }
-        let visible = ci * ndf.d(h) / ndf.projected_area(w);
-        let denom = ci + eta * co;
-        [(1.0 - fresnel::dielectric(eta, ci)) * visible * eta * eta * -co / (denom * denom); C]
+    }
+
+    fn refraction_eta(&self) -> Option<f64> {
+        Some(self.eta)
+    }
+
+    fn mirror_share(&self) -> f64 {
+        1.0
+    }
+
+    fn check(&self) -> Result<(), ParameterError> {
+        check_range("eta", &[self.eta], POSITIVE, "a finite number > 0")
     }
 }
 
@@ -289,6 +377,10 @@ impl<const C: usize> Facet<C> for Lambertian<C> {
         }
         let cosine = ndf.sample_visible(w, rng).dot(d).max(0.0) / PI;
         self.albedo.map(|a| a * cosine)
+    }
+
+    fn check(&self) -> Result<(), ParameterError> {
+        check_range("albedo", &self.albedo, 0.0..=1.0, "a number in [0, 1]")
     }
 }
 
@@ -336,6 +428,17 @@ impl<const C: usize> Facet<C> for Hammon<C> {
             let spec = specular.map_or(0.0, |(density, c)| fresnel::schlick(self.f0[i], c) * density);
             spec + (1.0 - fresnel::schlick(self.f0[i], ci)) * self.albedo[i] * exit
         })
+    }
+
+    /// Hammon's mirror part carries `F` (small at normal incidence, 1 at grazing); a fixed
+    /// half keeps both lobes in the importance density.
+    fn mirror_share(&self) -> f64 {
+        0.5
+    }
+
+    fn check(&self) -> Result<(), ParameterError> {
+        check_range("f0", &self.f0, 0.0..=1.0, "a number in [0, 1]")?;
+        check_range("albedo", &self.albedo, 0.0..=1.0, "a number in [0, 1]")
     }
 }
 

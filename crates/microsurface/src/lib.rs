@@ -14,6 +14,7 @@
 //! * [`facet`]: the micro-BSDF of a single facet (conductor, dielectric, Lambertian, Hammon);
 //! * [`material`]: a facet material chosen at run time, dispatching to its micro-BSDF;
 //! * [`walk`]: the random walk of Heitz et al. 2016 that composes them;
+//! * [`bsdf`]: the walk as a renderer's BSDF (`sample`, `eval`, `pdf`, per order);
 //! * [`single`]: exact single scattering, the walk's order-1 oracle;
 //! * [`beta`]: the Beta function of transmitted masking, exact towards the horizon;
 //! * [`slope`]: closed-form GGX masses and visible-normal probabilities of slope-space
@@ -50,6 +51,7 @@
 //! is in the repository's CHANGELOG.md.
 
 pub mod beta;
+pub mod bsdf;
 pub mod chain;
 pub mod facet;
 pub mod fresnel;

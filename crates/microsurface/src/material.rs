@@ -10,7 +10,9 @@
 use glam::DVec3;
 use rand::Rng;
 
-use crate::facet::{Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Interaction, Lambertian, Side};
+use crate::facet::{
+    Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Interaction, Lambertian, ParameterError, Side,
+};
 use crate::ndf::Ndf;
 
 /// The micro-BSDF of every facet, with `C` colour channels (1 or 3).
@@ -105,5 +107,17 @@ impl<const C: usize> Facet<C> for Material<C> {
         rng: &mut R,
     ) -> [f64; C] {
         dispatch!(self, f => f.phase(ndf, w, d, side, crosses, rng))
+    }
+
+    fn refraction_eta(&self) -> Option<f64> {
+        dispatch!(self, f => Facet::<C>::refraction_eta(f))
+    }
+
+    fn mirror_share(&self) -> f64 {
+        dispatch!(self, f => Facet::<C>::mirror_share(f))
+    }
+
+    fn check(&self) -> Result<(), ParameterError> {
+        dispatch!(self, f => Facet::<C>::check(f))
     }
 }

@@ -145,6 +145,28 @@ impl<N: Ndf> Microsurface<N> {
         interactions
     }
 
+    /// [`Microsurface::trace`] for a photon that never splits (`policy.never_splits(facet)`,
+    /// as [`Microsurface::walk_side_by_side`] requires; panics otherwise): its one ray needs
+    /// no scratch space, so a renderer's single-photon call allocates nothing.
+    pub fn trace_unsplit<F, R, O, const C: usize>(
+        &self,
+        facet: &F,
+        policy: &EnergyPolicy,
+        wi: DVec3,
+        rng: &mut R,
+        observer: &mut O,
+    ) -> u64
+    where
+        F: Facet<C>,
+        R: Rng + ?Sized,
+        O: Observer<C>,
+    {
+        assert!(policy.never_splits(facet), "trace_unsplit cannot split paths");
+        // Never pushed to: an empty `Vec` does not allocate.
+        let mut no_stack = Vec::new();
+        u64::from(self.follow(facet, policy, Ray::entering(wi), rng, &mut no_stack, observer))
+    }
+
     /// Walks `photons` photons arriving from `wi`, [`LANES`] at a time side by side, and
     /// reports each one's escape or loss to `observer`, followed by its end
     /// ([`Observer::end_photon`]). Each photon is walked exactly as by [`Microsurface::trace`];
