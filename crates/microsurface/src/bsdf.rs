@@ -6,8 +6,9 @@
 //!   `E[weight g(wo)] = ∫ f(wi, wo) |cos theta_o| g(wo) dwo` for every `g`, per channel.
 //! * [`Bsdf::eval`] is an unbiased estimate of `f(wi, wo) |cos theta_o|`: the order-1 term with
 //!   the depth of the first hit integrated out (exact for conductor and dielectric facets,
-//!   one visible normal for diffuse exits, §13.2), plus Heitz 2016's next-event estimate at
-//!   every later hit of one walk from `wi` (§4.7, §13.3).
+//!   one visible normal for diffuse exits, §13.2), plus Heitz 2016's next-event estimate
+//!   (§4.7) for every later hit of one walk from `wi`, with the event of that hit integrated
+//!   out (§13.3: bounded where Heitz's has infinite variance).
 //! * [`Bsdf::pdf`] is a deterministic density for multiple-importance weights: a mixture of the
 //!   visible-normal density of the order-1 specular lobe and a cosine lobe (§13.4). It is not
 //!   the density of `sample`'s directions (which has no closed form); MIS weights built on it
@@ -70,7 +71,8 @@ impl Orders {
     }
 }
 
-/// Which quantity a renderer transports, as Mitsuba's `TransportMode` (docs/rendering.md).
+/// Which quantity a renderer transports, as Mitsuba's `TransportMode` (§13.1,
+/// docs/rendering.md).
 ///
 /// The walk from `wi` carries light (power) that arrives from `wi`: its lobe is the BSDF
 /// `f(wi -> wo)` of light from `wi`, whose transmission part obeys
@@ -130,7 +132,7 @@ pub struct Sample<const C: usize> {
 /// The random stream of one BSDF call: PCG 64 (multiplicative congruential, 128-bit state).
 pub type Stream = rand_pcg::Pcg64Mcg;
 
-/// The stream of one call, from a renderer's 64-bit `key` (e.g. a hash of pixel, sample index
+/// The stream of one call (§13.5), from a renderer's 64-bit `key` (e.g. a hash of pixel, sample index
 /// and bounce) and any `numbers` it has at hand (Mitsuba's `sample` passes three uniforms;
 /// `eval` none, but the directions' components serve): every number's bit pattern is mixed
 /// into the key by SplitMix64's finalizer, so that different keys or numbers give
@@ -249,9 +251,9 @@ impl<N: Ndf, F: Facet<C>, const C: usize> Bsdf<N, F, C> {
     }
 
     /// An unbiased estimate of `f(wi, wo) |cos theta_o|` over the orders of the set, per
-    /// channel (§13.1): [`Bsdf::single_scattering`] for order 1, plus one walk from `wi` with
-    /// Heitz 2016's next-event estimate towards `wo` at its hits of order 2 and above (§4.7);
-    /// no walk when the set has no order above 1. 0 when `wi` cannot enter (see
+    /// channel: [`Bsdf::single_scattering`] for order 1, plus one walk from `wi` with a
+    /// next-event estimate towards `wo` for each of its hits of order 2 and above, the hit's
+    /// depth integrated out (§13.3); no walk when the set has no order above 1. 0 when `wi` cannot enter (see
     /// [`Bsdf::sample`]), when `wo` lies along the horizon, is not finite, or is on the other
     /// side of a surface that does not transmit. Never NaN, negative or infinite.
     ///
@@ -286,6 +288,29 @@ impl<N: Ndf, F: Facet<C>, const C: usize> Bsdf<N, F, C> {
         }
         let factor = if crosses { self.transmission_factor(side, transport) } else { 1.0 };
         sum.map(|s| finite_or_zero(s * factor))
+    }
+
+    /// [`Bsdf::eval`] from both ends (§13.3): the mean of the estimate from `wi` and of the
+    /// estimate from `wo` turned around by reciprocity (`eval(wo, wi)` in the other transport
+    /// mode, times `|cos theta_o| / |cos theta_i|`). Same expectation, twice the cost; it
+    /// pays where one end's estimate is heavy-tailed (grazing refraction into a dielectric:
+    /// about 2x less variance per unit of time) and loses where the other end's is (up to 2x
+    /// more).
+    pub fn eval_bidirectional<R: Rng + ?Sized>(
+        &self,
+        wi: DVec3,
+        wo: DVec3,
+        transport: Transport,
+        rng: &mut R,
+    ) -> [f64; C] {
+        let reverse = match transport {
+            Transport::Importance => Transport::Radiance,
+            Transport::Radiance => Transport::Importance,
+        };
+        let forward = self.eval(wi, wo, transport, rng);
+        let backward = self.eval(wo, wi, reverse, rng);
+        let turn = wo.z.abs() / wi.z.abs();
+        std::array::from_fn(|c| finite_or_zero(0.5 * (forward[c] + backward[c] * turn)))
     }
 
     /// The order-1 lobe `f_1(wi, wo) |cos theta_o|` of light from `wi` (§13.2): the facet's

@@ -419,6 +419,35 @@ fn eval_is_reciprocal() {
     }
 }
 
+/// `eval_bidirectional` has the expectation of `eval`: 100 000 calls of each at pairs that
+/// reflect and transmit (both modes, both sides), two-sample z test at the Sidak level for 4
+/// pairs in a family of 0.01.
+#[test]
+fn bidirectional_eval_has_the_mean_of_eval() {
+    let b = bsdf(ggx(0.6), glass());
+    let pairs = [
+        (dir(30.0, 0.0), dir(110.0, 20.0), Transport::Importance),
+        (dir(30.0, 0.0), dir(110.0, 20.0), Transport::Radiance),
+        (dir(140.0, 0.0), dir(60.0, 200.0), Transport::Radiance),
+        (dir(50.0, 0.0), dir(20.0, 120.0), Transport::Importance),
+    ];
+    let z_max = two_sided_z(sidak(0.01, pairs.len()));
+    let n = 100_000;
+    for (k, (wi, wo, transport)) in pairs.into_iter().enumerate() {
+        let mut rng = stream(30 + k as u64, &[]);
+        let (mut s1, mut q1, mut s2, mut q2) = (0.0, 0.0, 0.0, 0.0);
+        for _ in 0..n {
+            let (x, y) = (b.eval(wi, wo, transport, &mut rng)[0], b.eval_bidirectional(wi, wo, transport, &mut rng)[0]);
+            (s1, q1, s2, q2) = (s1 + x, q1 + x * x, s2 + y, q2 + y * y);
+        }
+        let nf = n as f64;
+        let (m1, m2) = (s1 / nf, s2 / nf);
+        let z = (m1 - m2) / ((q1 / nf - m1 * m1) / nf + (q2 / nf - m2 * m2) / nf).sqrt();
+        eprintln!("{wi} {wo} {transport:?}: eval {m1:.5}, bidirectional {m2:.5}, z {z:.2}");
+        assert!(m1 > 0.0 && z.abs() < z_max, "{wi} {wo} {transport:?}: {m1} vs {m2} (z {z})");
+    }
+}
+
 /// A transmission in radiance mode is the importance-mode value times `(n_i / n_o)^2`: the
 /// same walk (same seed) scaled, for `sample` and `eval`, from both sides.
 #[test]
