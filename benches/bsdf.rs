@@ -55,20 +55,19 @@ fn sample(bencher: divan::Bencher, index: usize) {
 
 #[divan::bench(args = 0..CASES.len(), sample_count = 20)]
 fn eval(bencher: divan::Bencher, index: usize) {
-    let (bsdf, wi) = case(index);
-    let mut rng = stream(2, &[]);
-    bencher.counter(divan::counter::ItemsCount::new(CALLS)).bench_local(|| {
-        for _ in 0..CALLS {
-            divan::black_box(bsdf.eval(divan::black_box(wi), outgoing(), Transport::Radiance, &mut rng));
-        }
-    });
+    bench_eval(bencher, index, Orders::ALL);
 }
 
 #[divan::bench(args = 0..CASES.len(), sample_count = 20)]
 fn eval_order_one(bencher: divan::Bencher, index: usize) {
+    bench_eval(bencher, index, Orders::only(1).expect("order 1 exists"));
+}
+
+/// `CALLS` evaluations of case `index` restricted to `orders`, towards [`outgoing`].
+fn bench_eval(bencher: divan::Bencher, index: usize, orders: Orders) {
     let (bsdf, wi) = case(index);
-    let bsdf = bsdf.with_orders(Orders::only(1).expect("order 1 exists"));
-    let mut rng = stream(3, &[]);
+    let bsdf = bsdf.with_orders(orders);
+    let mut rng = stream(2, &[]);
     bencher.counter(divan::counter::ItemsCount::new(CALLS)).bench_local(|| {
         for _ in 0..CALLS {
             divan::black_box(bsdf.eval(divan::black_box(wi), outgoing(), Transport::Radiance, &mut rng));
