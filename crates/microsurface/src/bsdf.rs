@@ -349,8 +349,8 @@ impl<N: Ndf, F: Facet<C>, const C: usize> Bsdf<N, F, C> {
     /// with the cosine lobe's weight `1 - s (1 - r)`: `s` the facet's
     /// [`Facet::mirror_share`], `r = alpha_x alpha_y / (1 + alpha_x alpha_y)` clamped to
     /// [0.05, 0.5] (multiple scattering grows with roughness). It approximates `sample`'s
-    /// density; 0 where `eval` is 0 by the rules of [`Bsdf::eval`], except on the far side of
-    /// a non-transmitting surface, where it is 0 too.
+    /// density. 0 where [`Bsdf::eval`] is 0 by rule: `wi` cannot enter, `wo` lies along the
+    /// horizon, is not finite, or is across a surface that does not transmit.
     pub fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
         let Some(side) = self.entry_side(wi) else { return 0.0 };
         if !wo.is_finite() || wo.z == 0.0 {
