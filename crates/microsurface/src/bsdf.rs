@@ -37,7 +37,9 @@ use crate::walk::{EnergyPolicy, Loss, Microsurface, Observer};
 /// for foreign interfaces; `from = u32::MAX` adds no tail.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Orders {
+    /// Bit `k - 1` set: order `k` (1 to 64) is in the set.
     pub mask: u64,
+    /// Every order from this one on is in the set (`u32::MAX`: none).
     pub from: u32,
 }
 
@@ -95,7 +97,12 @@ pub enum BsdfError {
     Parameter(ParameterError),
     /// The surface uses a model whose BSDF is not the one `eval` computes: its order-1 term and
     /// next-event estimates assume the true Smith Lambda and visible normals (§2.6, §3.1).
-    Model { field: &'static str, allowed: &'static str },
+    Model {
+        /// The surface's field: `smith` or `normals`.
+        field: &'static str,
+        /// What the BSDF needs there.
+        allowed: &'static str,
+    },
 }
 
 impl std::fmt::Display for BsdfError {
@@ -190,14 +197,17 @@ impl<N: Ndf, F: Facet<C>, const C: usize> Bsdf<N, F, C> {
         Bsdf { orders, ..self }
     }
 
+    /// The orders this BSDF is restricted to.
     pub fn orders(&self) -> Orders {
         self.orders
     }
 
+    /// The microsurface: NDF, Smith variant and law of the hit normals.
     pub fn surface(&self) -> &Microsurface<N> {
         &self.surface
     }
 
+    /// The facet material.
     pub fn facet(&self) -> &F {
         &self.facet
     }

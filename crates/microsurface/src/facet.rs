@@ -111,8 +111,11 @@ pub trait Facet<const C: usize>: Send + Sync {
 /// A parameter out of its allowed range: which one, its value and what is allowed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParameterError {
+    /// The parameter's name as configurations and renderers spell it (`eta`, `alpha_x`, ...).
     pub field: &'static str,
+    /// The value given (the first channel out of range for a per-channel parameter).
     pub value: f64,
+    /// What is allowed, in words.
     pub allowed: &'static str,
 }
 
