@@ -65,6 +65,7 @@
 
 pub mod analysis;
 pub mod atomic;
+pub mod commands;
 pub mod engine;
 pub mod exports;
 pub mod io;
