@@ -21,11 +21,6 @@ use std::path::Path;
 /// The layers from bottom to top; a module's layer is that of its first path segment.
 const LAYERS: [&str; 7] = ["setup", "engine", "io", "analysis", "exports", "commands", "main"];
 
-/// Circles tolerated while a rewrite removes them: `setup::config` <-> `setup::cases` (issue
-/// 35, the configuration split by section). When no circle inside `setup` is left the test
-/// fails, so that this exemption goes too.
-const TOLERATED_CYCLE_LAYER: Option<&str> = Some("setup");
-
 /// An import of one module by another: where it is written and the path as written.
 #[derive(Clone, Debug)]
 struct Import {
@@ -382,28 +377,16 @@ fn circles(files: &BTreeMap<String, String>, graph: &Graph) -> Vec<(BTreeSet<Str
     out
 }
 
-/// The failures of the check on `files`: circles (except a tolerated layer's) and imports
-/// against the layer order, each naming the offending import.
-fn check(files: &BTreeMap<String, String>, tolerated: Option<&str>) -> Vec<String> {
+/// The failures of the check on `files`: circles and imports against the layer order, each
+/// naming the offending import.
+fn check(files: &BTreeMap<String, String>) -> Vec<String> {
     let graph = graph(files);
     let mut failures = Vec::new();
-    let mut tolerated_seen = false;
     for (component, edges) in circles(files, &graph) {
-        if tolerated.is_some_and(|t| component.iter().all(|m| layer(m) == layer(t))) {
-            tolerated_seen = true;
-            continue;
-        }
         failures.push(format!(
             "import circle between {}:\n    {}",
             component.iter().cloned().collect::<Vec<_>>().join(", "),
             edges.join("\n    ")
-        ));
-    }
-    if let Some(t) = tolerated
-        && !tolerated_seen
-    {
-        failures.push(format!(
-            "no import circle is left inside `{t}`: remove the exemption TOLERATED_CYCLE_LAYER in tests/architecture.rs"
         ));
     }
     for (from, edges) in &graph {
@@ -442,8 +425,7 @@ fn sources(root: &Path, dir: &Path, out: &mut BTreeMap<String, String>) {
     }
 }
 
-/// `src/` keeps the layer order of docs/architecture.md and has no import circle (but the
-/// tolerated one, see [`TOLERATED_CYCLE_LAYER`]).
+/// `src/` keeps the layer order of docs/architecture.md and has no import circle.
 #[test]
 fn src_has_no_import_circles_and_keeps_the_layer_order() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
@@ -453,7 +435,7 @@ fn src_has_no_import_circles_and_keeps_the_layer_order() {
     let graph = graph(&files);
     // The graph is read: main uses the commands, which use every layer below.
     assert!(graph["main"].contains_key("commands::run") && graph["commands::run"].contains_key("engine::checkpoint"));
-    let failures = check(&files, TOLERATED_CYCLE_LAYER);
+    let failures = check(&files);
     assert!(failures.is_empty(), "docs/architecture.md, \"Rules the code keeps\":\n{}", failures.join("\n"));
 }
 
@@ -476,7 +458,7 @@ fn the_check_reports_planted_circles_and_upward_imports() {
         for (f, s) in extra {
             files.entry(f.to_string()).or_default().push_str(s);
         }
-        check(&files, None)
+        check(&files)
     };
     assert_eq!(tree(&[]), Vec::<String>::new(), "comments and strings are not imports");
 
