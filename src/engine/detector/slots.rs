@@ -59,7 +59,7 @@ pub struct Tallies<const C: usize> {
     pub orders: Vec<OrderTallies<C>>,
     /// Per photon: escaped plus lost weight (absorbed = 1 - this).
     pub accounted: Moments<C>,
-    /// Per photon: weight lost, per [`Loss`] reason (trapped, invalid, runaway).
+    /// Per photon: weight lost, per [`Loss`](microsurface::walk::Loss) reason (trapped, invalid, runaway).
     pub lost: [Tally<C>; 3],
     pub photons: u64,
     /// Facet interactions of all rays of all photons (the walk's work, for throughput figures).
