@@ -60,11 +60,13 @@
 //! each case with the [`microsurface`] crate in fixed chunks and bins the escaping light in a
 //! [`engine::detector::Detector`]; [`io`] writes the run directory and reads it back; the
 //! [`analysis`] compares measurements with analytic models; the [`exports`] turn a run into
-//! figures, energy-compensation tables and measured-BRDF files. A lower layer never imports a
-//! higher one; [`atomic`] (whole-or-nothing file writes) serves them all.
+//! figures, energy-compensation tables and measured-BRDF files; the [`commands`] are the command
+//! line's subcommands, on top of every layer. A lower layer never imports a higher one
+//! (`tests/architecture.rs` checks it); [`atomic`] (whole-or-nothing file writes) serves them all.
 
 pub mod analysis;
 pub mod atomic;
+pub mod commands;
 pub mod engine;
 pub mod exports;
 pub mod io;

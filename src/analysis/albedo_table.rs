@@ -12,8 +12,6 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-use crate::analysis::compensation::Albedo;
-
 /// The quantity of `lut.csv` that the compensation models need: reflection, order 1 (single
 /// scattering) of the F = 1 conductor table.
 const QUANTITY: &str = "R_1";
@@ -149,10 +147,10 @@ impl AlbedoTable {
         Ok(AlbedoTable { path: e_path, alpha, mu, e, avg_alpha, e_avg })
     }
 
-    /// `E(mu)` and `E_avg` at roughness `alpha`: the rows of `E` interpolated linearly in
-    /// alpha (clamped), so that the result, linear in mu between the mu nodes (clamped), is the
-    /// table's bilinear interpolation; `E_avg` linear in alpha (clamped).
-    pub fn albedo(&self, alpha: f64) -> Albedo {
+    /// `E` at the `mu` nodes and `E_avg`, at roughness `alpha`: the rows of `E` interpolated
+    /// linearly in alpha (clamped), so that the result, linear in mu between the mu nodes
+    /// (clamped), is the table's bilinear interpolation; `E_avg` linear in alpha (clamped).
+    pub fn at_alpha(&self, alpha: f64) -> (Vec<f64>, f64) {
         let n = self.mu.len();
         let row: Vec<f64> = (0..n)
             .map(|j| {
@@ -160,7 +158,7 @@ impl AlbedoTable {
                 linear(&self.alpha, &column, alpha)
             })
             .collect();
-        Albedo::linear(self.mu.clone(), row, linear(&self.avg_alpha, &self.e_avg, alpha))
+        (row, linear(&self.avg_alpha, &self.e_avg, alpha))
     }
 
     /// A one-line description for the report.

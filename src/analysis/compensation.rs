@@ -321,7 +321,7 @@ impl Panel {
 /// between them; `average` is `E_avg = 2 ∫ E(mu) mu dmu`, the Gauss–Legendre sum of the same
 /// nodes (exact for the interpolant) plus the part below [`MU_MIN`]. The interpolant differs
 /// from direct quadrature by at most 1e-6 (GGX and Beckmann, alpha 0.01 to 3; measured in
-/// `tests/compensation.rs`: 7.7e-7 at Beckmann alpha 3, `mu = 1`). [`Albedo::linear`] is the
+/// `tests/compensation.rs`: 7.7e-7 at Beckmann alpha 3, `mu = 1`). [`Albedo::from_table`] is the
 /// other kind: a row of a user's table.
 #[derive(Clone, Debug)]
 pub struct Albedo {
@@ -373,11 +373,12 @@ impl Albedo {
         Albedo { shape: Shape::Panels(panels), average }
     }
 
-    /// `E(mu)` given at increasing `mu` nodes (at least 2), linear between them and held at the
-    /// first and last node's value outside them, with its `average` given too (a row of an
-    /// [`AlbedoTable`]).
-    pub fn linear(mu: Vec<f64>, e: Vec<f64>, average: f64) -> Self {
-        Albedo { shape: Shape::Linear { mu, e }, average }
+    /// `E(mu)` of `table` at roughness `alpha` ([`AlbedoTable::at_alpha`]), given at its
+    /// increasing `mu` nodes, linear between them and held at the first and last node's value
+    /// outside them, with its `E_avg`.
+    pub fn from_table(table: &AlbedoTable, alpha: f64) -> Self {
+        let (e, average) = table.at_alpha(alpha);
+        Albedo { shape: Shape::Linear { mu: table.mu.clone(), e }, average }
     }
 
     /// `E(mu)` for `mu` in `[0, 1]` (exact: held at `E(MU_MIN)` below [`MU_MIN`], as
@@ -482,7 +483,7 @@ impl AlbedoCache {
             Some(i) => i,
             None => {
                 let albedo = match (&self.table, ndf) {
-                    (Some(table), _) if f == Fresnel::One => table.albedo(ndf.roughness().x),
+                    (Some(table), _) if f == Fresnel::One => Albedo::from_table(table, ndf.roughness().x),
                     (_, AnyNdf::Ggx(ndf)) => Albedo::exact(&ndf, f),
                     (_, AnyNdf::Beckmann(ndf)) => Albedo::exact(&ndf, f),
                 };

@@ -8,10 +8,11 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::cases::{groups, pretty_fields};
+use super::points::{Points, bar_top};
+use super::rows::{Row, all_orders_only, folded_note, open_row, row_label};
+use super::selection::Selection;
 use super::style::{self, CAPTION, FONT, Figure, Key, TICK, draw_err};
-use super::{
-    Points, Row, Selection, all_orders_only, bar_top, folded_note, groups, open_row, pretty_fields, row_label,
-};
 use crate::io::rundir::{RunDir, SummaryRow};
 use crate::setup::cases::Case;
 

@@ -24,8 +24,10 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 
+use super::cases::surface_label;
+use super::rows::{Row, folded_note, highest_slot, row_bins, row_label};
+use super::selection::Selection;
 use super::style::{self, CAPTION, FONT, Figure, LABEL, TICK, TITLE, draw_err};
-use super::{Row, Selection, highest_slot, row_bins, row_label, surface_label};
 use crate::engine::detector::Grid;
 use crate::io::rundir::{BinValue, Lobes, RunDir};
 use crate::setup::cases::Case;
@@ -331,7 +333,7 @@ impl HeatFigure<'_> {
             self.case.index,
             surface_label(self.run, self.case),
             self.case.theta_i_deg,
-            super::folded_note(self.run, self.rows, false),
+            folded_note(self.run, self.rows, false),
             self.selection.note(),
         )
     }

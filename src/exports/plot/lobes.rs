@@ -9,11 +9,11 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::cases::surface_label;
+use super::points::{Points, bar_top};
+use super::rows::{Row, all_orders_only, folded_note, highest_slot, row_bins, row_label};
+use super::selection::Selection;
 use super::style::{self, CAPTION, FONT, Figure, Key, MEASURED, TICK, draw_err};
-use super::{
-    Points, Row, Selection, all_orders_only, bar_top, folded_note, highest_slot, plane_of_incidence, row_bins,
-    row_label, surface_label,
-};
 use crate::analysis::compare::is_monte_carlo;
 use crate::io::rundir::{BinValue, Lobes, RunDir};
 use crate::setup::cases::Case;
@@ -253,10 +253,28 @@ impl Figure for LobeFigure<'_> {
     }
 }
 
+/// The lobe f |cos theta_o| in the plane of incidence: (signed theta_o in degrees, value,
+/// standard error), light's side negative, mirror side positive.
+fn plane_of_incidence(run: &RunDir, bins: &[BinValue]) -> Points {
+    let g = run.grid;
+    let dphi = std::f64::consts::TAU / g.phi_bins as f64;
+    let dcos = 1.0 / g.cos_bins as f64;
+    let mut points = Vec::new();
+    for (ip, sign) in [(0, -1.0), (g.phi_bins / 2, 1.0)] {
+        for ic in 0..g.cos_bins {
+            let b = bins[ic * g.phi_bins + ip];
+            let theta = ((ic as f64 + 0.5) * dcos).acos().to_degrees();
+            points.push((sign * theta, b.energy / (dcos * dphi), b.energy_stderr / (dcos * dphi)));
+        }
+    }
+    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    points
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::exports::plot::tests::written_run;
+    use crate::exports::plot::rows::tests::written_run;
 
     #[test]
     fn wide_sweeps_wrap_into_balanced_blocks() {
@@ -311,7 +329,7 @@ mod tests {
                 .collect(),
         };
         let cases: Vec<&Case> = run.cases.iter().collect();
-        let rows = super::super::rows(2);
+        let rows = super::super::rows::rows(2);
         let drawn = |single_error: f64| {
             let models: BTreeMap<String, Lobes> =
                 [("heitz-nee".to_string(), model(1.0, 0.3)), ("single".to_string(), model(0.6, single_error))].into();
@@ -337,5 +355,23 @@ mod tests {
             caption.contains("Monte Carlo models (heitz-nee)") && caption.contains("±1 standard error"),
             "{caption}"
         );
+    }
+
+    #[test]
+    fn plane_of_incidence_puts_the_mirror_side_at_positive_angles() {
+        let (_dir, run) = written_run(
+            "paths = 10\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 30\n[detector]\ncos_theta_bins = 4\nphi_bins = 8\n",
+        );
+        // Energy 0.1 only in cos bin 2 (|cos| in [0.5, 0.75)), phi bin 4 (phi in [180, 225) deg).
+        let mut bins = vec![BinValue::default(); 32];
+        bins[2 * 8 + 4].energy = 0.1;
+        let points = plane_of_incidence(&run, &bins);
+        assert_eq!(points.len(), 8);
+        let lit: Vec<_> = points.iter().filter(|p| p.1 > 0.0).collect();
+        assert_eq!(lit.len(), 1);
+        let expected_theta = 0.625_f64.acos().to_degrees();
+        assert!((lit[0].0 - expected_theta).abs() < 1e-12, "{:?}", lit[0]);
+        // f |cos| = energy / (d|cos| dphi) = 0.1 / (0.25 * pi / 4).
+        assert!((lit[0].1 - 0.1 / (0.25 * std::f64::consts::FRAC_PI_4)).abs() < 1e-12);
     }
 }

@@ -9,11 +9,20 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use super::{Drawn, Selection, describe, pretty_fields, slot_label, surface_label, varying};
+use super::cases::{describe, pretty_fields, surface_label, varying};
+use super::rows::slot_label;
+use super::selection::Selection;
 use crate::analysis::stats::sidak;
 use crate::io::output::{CASE_COLUMNS, case_fields};
 use crate::io::rundir::{Lobes, RunDir, Table};
 use crate::setup::cases::Case;
+
+/// A figure drawn and the caption the report shows under it.
+pub(super) struct Drawn {
+    pub(super) name: String,
+    pub(super) bytes: Vec<u8>,
+    pub(super) caption: String,
+}
 
 /// The family-wise significance level of the comparison verdicts (Sidak over a model's lobes),
 /// as in `smithwalk compare`.

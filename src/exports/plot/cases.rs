@@ -1,0 +1,86 @@
+//! How a run's cases are grouped into figures and named in titles and captions.
+
+use std::collections::BTreeMap;
+
+use crate::io::output::{CASE_COLUMNS, case_fields};
+use crate::io::rundir::RunDir;
+use crate::setup::cases::Case;
+
+/// The case fields without the case index and the columns `swept`, which identify a group of
+/// cases that differ only in those columns.
+fn group_key(case: &Case, swept: &[usize]) -> Vec<String> {
+    case_fields(case).into_iter().enumerate().filter(|(i, _)| *i != 0 && !swept.contains(i)).map(|(_, f)| f).collect()
+}
+
+/// Cases that differ only in the columns `swept` (indices into `CASE_COLUMNS`), in order of
+/// their first case, each sorted by the incident angle.
+pub(super) fn groups<'a>(cases: impl IntoIterator<Item = &'a Case>, swept: &[usize]) -> Vec<Vec<&'a Case>> {
+    let mut map: BTreeMap<Vec<String>, Vec<&Case>> = BTreeMap::new();
+    for case in cases {
+        map.entry(group_key(case, swept)).or_default().push(case);
+    }
+    let mut out: Vec<Vec<&Case>> = map.into_values().collect();
+    out.sort_by_key(|cases| cases[0].index);
+    for cases in &mut out {
+        cases.sort_by(|a, b| a.theta_i_deg.total_cmp(&b.theta_i_deg).then(a.roughness().x.total_cmp(&b.roughness().x)));
+    }
+    out
+}
+
+/// The indices of the case columns (after `case`) whose value differs between cases.
+pub(super) fn varying(cases: &[Case]) -> Vec<usize> {
+    let fields: Vec<Vec<String>> = cases.iter().map(case_fields).collect();
+    (1..CASE_COLUMNS.len()).filter(|&c| fields.iter().any(|f| f[c] != fields[0][c])).collect()
+}
+
+/// How a case column reads in captions: a name and the value (`α_x = 0.5`, `θ_i = 30°`).
+fn pretty_field(column: usize, value: &str) -> String {
+    match CASE_COLUMNS[column] {
+        "alpha_x" => format!("α_x = {value}"),
+        "alpha_y" => format!("α_y = {value}"),
+        "theta_i_deg" => format!("θ_i = {:.1}°", value.parse::<f64>().unwrap_or(f64::NAN)),
+        "phi_i_deg" => format!("φ_i = {value}°"),
+        "material" => value.to_string(),
+        "side" => format!("light from {value}"),
+        name => format!("{name} {value}"),
+    }
+}
+
+/// The fields of `case` that vary over the run, except those of `skip`, for captions.
+pub(super) fn pretty_fields(run: &RunDir, case: &Case, skip: &[usize]) -> String {
+    let columns: Vec<usize> = varying(&run.cases).into_iter().filter(|c| !skip.contains(c)).collect();
+    describe(&case_fields(case), &columns).join(", ")
+}
+
+/// How the case columns `columns` of a case (its `fields`) read in captions, an isotropic
+/// roughness as one value.
+pub(super) fn describe(fields: &[String], columns: &[usize]) -> Vec<String> {
+    let isotropic = columns.contains(&2) && columns.contains(&3) && fields[2] == fields[3];
+    columns
+        .iter()
+        .filter(|&&c| !(isotropic && c == 3))
+        .map(|&c| if isotropic && c == 2 { format!("α = {}", fields[2]) } else { pretty_field(c, &fields[c]) })
+        .collect()
+}
+
+/// A self-contained name of a case's surface and material (NDF, roughness, material, and the
+/// Smith and normals settings when they are not the defaults) and the side the light comes
+/// from, named when it is not outside or when the run has both sides.
+pub(super) fn surface_label(run: &RunDir, case: &Case) -> String {
+    let alpha = if case.roughness().x == case.roughness().y {
+        format!("α = {}", case.roughness().x)
+    } else {
+        format!("α = ({}, {})", case.roughness().x, case.roughness().y)
+    };
+    let fields = case_fields(case);
+    let mut label = format!("{}, {alpha}, {}", fields[1].to_uppercase(), fields[7]);
+    for (column, default) in [(5, "exact"), (6, "vndf")] {
+        if fields[column] != default {
+            label.push_str(&format!(", {} {}", CASE_COLUMNS[column], fields[column]));
+        }
+    }
+    if fields[10] != "outside" || varying(&run.cases).contains(&10) {
+        label.push_str(&format!(", {}", pretty_field(10, &fields[10])));
+    }
+    label
+}
