@@ -43,15 +43,6 @@ impl<const C: usize> Material<C> {
             Material::Hammon(_) => "hammon",
         }
     }
-
-    /// The Fresnel reflectance of a conductor's facets in channel `channel` for the cosine `c`
-    /// between the incident direction and the facet normal; `None` for other materials.
-    pub fn conductor_fresnel(&self, channel: usize, c: f64) -> Option<f64> {
-        match self {
-            Material::Conductor(conductor) => Some(conductor.fresnel.reflectance(channel, c)),
-            _ => None,
-        }
-    }
 }
 
 impl Material<3> {
