@@ -37,8 +37,9 @@ use crate::atomic::write_atomically;
 use crate::engine::detector::{Detector, Hemisphere};
 use crate::engine::run::{CaseResult, ChainModel, Estimator, Shard};
 use crate::engine::{RunOptions, Simulation};
-use crate::io::output::{CASE_COLUMNS, bin_edges, case_fields, hemisphere_sign, hemispheres};
+use crate::io::output::{bin_edges, case_fields, hemisphere_sign, hemispheres};
 use crate::io::rundir::{BinValue, LobeId, Lobes, RunDir};
+use crate::io::schema;
 use crate::setup::cases::Case;
 use crate::setup::config::{Config, Model};
 
@@ -746,7 +747,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
         .collect();
     let compare_csv = compare_table(&comparisons, &run, &verdicts, options.family_level, rgb, folded)?;
     let models_csv = models_table(&run, &predicted, rgb, folded)?;
-    write_atomically(run_dir, &[("models.csv", models_csv), ("compare.csv", compare_csv)])?;
+    write_atomically(run_dir, &[(schema::MODELS.file, models_csv), (schema::COMPARE.file, compare_csv)])?;
     let report = report(&comparisons, &verdicts, &notes, options.family_level, rgb, folded, options.default_models);
     Ok(Outcome { report, verdicts })
 }
@@ -772,14 +773,8 @@ fn models_table(
     folded: Option<usize>,
 ) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<String> = ["case", "order", "hemisphere"].map(String::from).into();
-    if rgb {
-        header.push("channel".into());
-    }
-    header.extend(["cos_lo", "cos_hi", "phi_lo_deg", "phi_hi_deg", "folded"].map(String::from));
-    for (model, _) in predicted {
-        header.extend([model.name().to_string(), format!("{}_stderr", model.name())]);
-    }
+    let names: Vec<&str> = predicted.iter().map(|(model, _)| model.name()).collect();
+    let header = schema::MODELS.header(rgb, &names);
     w.write_record(&header)?;
     let channels = if rgb { 3 } else { 1 };
     let zeros = vec![0.0; run.grid.bins()];
@@ -846,27 +841,7 @@ fn compare_table(
     folded: Option<usize>,
 ) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<&str> = CASE_COLUMNS.to_vec();
-    header.extend(["model", "order", "hemisphere"]);
-    if rgb {
-        header.push("channel");
-    }
-    header.extend([
-        "chi2",
-        "dof",
-        "p_value",
-        "rel_l1",
-        "rel_l2",
-        "albedo_measured",
-        "albedo_measured_stderr",
-        "albedo_model",
-        "albedo_model_stderr",
-        "albedo_diff_se",
-        "folded",
-        "family_level",
-        "lobe_level",
-        "rejected",
-    ]);
+    let header = schema::COMPARE.header(rgb, &[]);
     w.write_record(&header)?;
     for c in comparisons {
         let lobes = verdicts.iter().find(|v| v.model == c.model).map_or(1, |v| v.lobes);

@@ -22,7 +22,20 @@ use anyhow::{Context, Result, bail};
 use crate::engine::detector::{Grid, Hemisphere};
 use crate::io::output::hemisphere_sign;
 use crate::io::rundir::RunDir;
+use crate::io::schema::{self, Column};
 use crate::setup::cases::Case;
+
+/// The columns an external model's CSV must have (in any order; others are ignored).
+const REQUIRED: [Column; 8] = [
+    schema::CASE,
+    schema::ORDER,
+    schema::HEMISPHERE,
+    schema::COS_LO,
+    schema::COS_HI,
+    schema::PHI_LO_DEG,
+    schema::PHI_HI_DEG,
+    schema::ENERGY,
+];
 
 /// A nominal photon count for a model with standard errors: large enough that the two-sample
 /// test's variance of the model is its `energy_stderr^2` (the count itself drops out).
@@ -64,18 +77,25 @@ pub fn read(path: &Path, run: &RunDir) -> Result<ExternalModel> {
     let file = path.display();
     let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read external model {file}"))?;
     let headers = reader.headers().with_context(|| format!("{file}: cannot read the header line"))?.clone();
-    let column = |name: &str| headers.iter().position(|h| h.trim() == name);
-    let required = |name: &str| {
-        column(name).with_context(|| {
-            format!("{file}: no column `{name}` (needed: case, order, hemisphere, cos_lo, cos_hi, phi_lo_deg, phi_hi_deg, energy)")
+    let column = |c: Column| headers.iter().position(|h| h.trim() == c.name);
+    let required = |c: Column| {
+        column(c).with_context(|| {
+            let needed: Vec<&str> = REQUIRED.iter().map(|c| c.name).collect();
+            format!("{file}: no column `{}` (needed: {})", c.name, needed.join(", "))
         })
     };
-    let (case_col, order_col, hemi_col) = (required("case")?, required("order")?, required("hemisphere")?);
-    let bounds = [required("cos_lo")?, required("cos_hi")?, required("phi_lo_deg")?, required("phi_hi_deg")?];
-    let energy_col = required("energy")?;
-    let stderr_col = column("energy_stderr");
+    let (case_col, order_col, hemi_col) =
+        (required(schema::CASE)?, required(schema::ORDER)?, required(schema::HEMISPHERE)?);
+    let bounds = [
+        required(schema::COS_LO)?,
+        required(schema::COS_HI)?,
+        required(schema::PHI_LO_DEG)?,
+        required(schema::PHI_HI_DEG)?,
+    ];
+    let energy_col = required(schema::ENERGY)?;
+    let stderr_col = column(schema::ENERGY_STDERR);
     let rgb = config.is_rgb();
-    let channel_col = column("channel");
+    let channel_col = column(schema::CHANNEL);
     if rgb && channel_col.is_none() {
         bail!("{file}: no column `channel`, and the run is RGB (give r, g and b rows)");
     }

@@ -10,6 +10,7 @@ use crate::atomic::write_atomically;
 use crate::engine::Simulation;
 use crate::engine::detector::{Detector, Grid, Hemisphere, Moments, Tally};
 use crate::engine::run::CaseResult;
+use crate::io::schema;
 use crate::setup::cases::Case;
 use microsurface::ndf::Roughness;
 use microsurface::normals::Normals;
@@ -27,10 +28,7 @@ pub(crate) fn name<T: Serialize>(value: &T) -> String {
     }
 }
 
-/// The leading columns that identify a case.
-pub(crate) const CASE_COLUMNS: [&str; 11] =
-    ["case", "ndf", "alpha_x", "alpha_y", "height", "smith", "normals", "material", "theta_i_deg", "phi_i_deg", "side"];
-
+/// The values of a case's leading columns ([`schema::CASE_COLUMNS`]).
 pub(crate) fn case_fields(case: &Case) -> Vec<String> {
     vec![
         case.index.to_string(),
@@ -226,10 +224,6 @@ pub fn balance_table(sim: &Simulation) -> String {
     text
 }
 
-fn channel_header(rgb: bool) -> Vec<&'static str> {
-    if rgb { vec!["channel"] } else { vec![] }
-}
-
 /// The bins of a lobe in the order of `lobes.csv` (and `models.csv`): cos index, then phi
 /// index, each as `(cos index, bin index, [cos_lo, cos_hi, phi_lo_deg, phi_hi_deg])` with the
 /// cos edges signed by the hemisphere's `sign` ([`hemisphere_sign`]).
@@ -325,23 +319,7 @@ fn summary_rows<const C: usize>(w: &mut csv::Writer<Vec<u8>>, case: &Case, d: &D
 /// for materials that transmit), bin (every bin, empty ones too) and channel (RGB runs).
 pub fn lobes_csv(sim: &Simulation) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<&str> = CASE_COLUMNS.to_vec();
-    header.extend(["order", "hemisphere"]);
-    header.extend(channel_header(sim.rgb));
-    header.extend([
-        "cos_lo",
-        "cos_hi",
-        "phi_lo_deg",
-        "phi_hi_deg",
-        "energy",
-        "energy_stderr",
-        "count",
-        "bsdf",
-        "bsdf_stderr",
-        "theta_o_deg",
-        "phi_o_deg",
-        "solid_angle",
-    ]);
+    let header = schema::LOBES.header(sim.rgb, &[]);
     w.write_record(&header)?;
     for (case, result) in sim.cases.iter().zip(&sim.results) {
         match result {
@@ -355,10 +333,7 @@ pub fn lobes_csv(sim: &Simulation) -> Result<Vec<u8>> {
 /// The CSV text of `summary.csv` (albedo per case, order, hemisphere; absorbed; lost).
 pub fn summary_csv(sim: &Simulation) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<&str> = CASE_COLUMNS.to_vec();
-    header.extend(["paths", "order", "hemisphere"]);
-    header.extend(channel_header(sim.rgb));
-    header.extend(["albedo", "albedo_stderr", "albedo_vov", "folded"]);
+    let header = schema::SUMMARY.header(sim.rgb, &[]);
     w.write_record(&header)?;
     for (case, result) in sim.cases.iter().zip(&sim.results) {
         match result {
@@ -421,14 +396,13 @@ pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
 }
 
 /// The tables of a run, named as in its directory; `run.json` records their digests.
-pub const TABLES: [&str; 2] = ["lobes.csv", "summary.csv"];
-
-/// Files that `compare` derives from a run: a new run into the directory removes them.
-pub const DERIVED: [&str; 2] = ["models.csv", "compare.csv"];
+pub const TABLES: [&str; 2] = [schema::LOBES.file, schema::SUMMARY.file];
 
 #[derive(Serialize)]
 struct RunReport<'a> {
     smithwalk_version: &'static str,
+    /// The run directory's format ([`schema::FORMAT_VERSION`]).
+    format_version: u32,
     /// Identifies this run: the digest of its tables and the time it finished.
     run_id: String,
     /// `lobes.csv` and `summary.csv` as written, with their digests.
@@ -470,15 +444,11 @@ pub fn run_json(sim: &Simulation, config: &Config, tables: [&[u8]; 2]) -> Result
         .map(|(name, bytes)| (name, FileRecord { bytes: bytes.len() as u64, sha256: sha256_hex(bytes) }))
         .collect();
     let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
-    let stamp = format!(
-        "{} {} {} {}",
-        files["lobes.csv"].sha256,
-        files["summary.csv"].sha256,
-        now.as_nanos(),
-        std::process::id()
-    );
+    let stamp =
+        format!("{} {} {} {}", files[TABLES[0]].sha256, files[TABLES[1]].sha256, now.as_nanos(), std::process::id());
     let report = RunReport {
         smithwalk_version: env!("CARGO_PKG_VERSION"),
+        format_version: schema::FORMAT_VERSION,
         run_id: sha256_hex(stamp.as_bytes())[..32].to_string(),
         files,
         config,
@@ -510,7 +480,7 @@ pub fn run_json(sim: &Simulation, config: &Config, tables: [&[u8]; 2]) -> Result
 pub fn write_outputs(sim: &Simulation, config: &Config, dir: &Path) -> Result<Vec<PathBuf>> {
     let (lobes, summary) = (lobes_csv(sim)?, summary_csv(sim)?);
     let run = run_json(sim, config, [&lobes, &summary])?;
-    for stale in DERIVED {
+    for stale in schema::COMPARE_FILES {
         match std::fs::remove_file(dir.join(stale)) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
                 return Err(anyhow::Error::new(e).context(format!("cannot remove the previous run's {stale}")));
@@ -518,7 +488,7 @@ pub fn write_outputs(sim: &Simulation, config: &Config, dir: &Path) -> Result<Ve
             _ => {}
         }
     }
-    write_atomically(dir, &[(TABLES[0], lobes), (TABLES[1], summary), ("run.json", run)])
+    write_atomically(dir, &[(TABLES[0], lobes), (TABLES[1], summary), (schema::RUN_JSON, run)])
 }
 
 #[cfg(test)]

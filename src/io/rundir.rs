@@ -18,6 +18,7 @@ use serde::Deserialize;
 use crate::atomic::{DirLock, lock_dir};
 use crate::engine::detector::Grid;
 use crate::io::output::{TABLES, self_digest, sha256_hex};
+use crate::io::schema::{self, Column};
 use crate::setup::cases::Case;
 use crate::setup::config::Config;
 
@@ -36,11 +37,14 @@ impl Table {
         Ok(Self { path: path.to_path_buf(), headers, records })
     }
 
-    pub fn column(&self, name: &str) -> Result<usize> {
-        self.headers
-            .iter()
-            .position(|h| h == name)
-            .with_context(|| format!("{}: no column {name}", self.path.display()))
+    /// The index of `column`, which the table must have.
+    pub fn column(&self, column: Column) -> Result<usize> {
+        self.optional(column).with_context(|| format!("{}: no column {}", self.path.display(), column.name))
+    }
+
+    /// The index of `column`, if the table has it.
+    pub fn optional(&self, column: Column) -> Option<usize> {
+        self.headers.iter().position(|h| h == column.name)
     }
 }
 
@@ -53,6 +57,9 @@ pub fn read_config(run_dir: &Path) -> Result<Config> {
 /// What `run.json` says of the run beyond its config.
 #[derive(Deserialize)]
 struct RunJson {
+    /// Absent in run directories written before the format had a version (those are format 1).
+    #[serde(default)]
+    format_version: Option<u32>,
     config: Config,
     #[serde(default)]
     files: Option<HashMap<String, FileRecord>>,
@@ -114,7 +121,7 @@ impl Shape<'_> {
 
 /// `run.json` of `dir`, checked against the tables beside it.
 fn read_run_json(dir: &Path) -> Result<RunJson> {
-    let path = dir.join("run.json");
+    let path = dir.join(schema::RUN_JSON);
     let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
     match self_digest(text.as_bytes()) {
         Some((range, digest)) if text.get(range.clone()) == Some(digest.as_str()) => {}
@@ -127,6 +134,14 @@ fn read_run_json(dir: &Path) -> Result<RunJson> {
     }
     let run: RunJson = serde_json::from_str(&text)
         .with_context(|| format!("{} is not the run.json of a finished smithwalk run", path.display()))?;
+    if let Some(version) = run.format_version.filter(|&v| v > schema::FORMAT_VERSION) {
+        bail!(
+            "{}: format_version = {version} is not allowed: this smithwalk reads run directories of format {} or \
+             older (docs/run-directory.md); open it with a newer smithwalk",
+            path.display(),
+            schema::FORMAT_VERSION
+        );
+    }
     run.config.validate().with_context(|| format!("{}: the run's config", path.display()))?;
     let Some(files) = &run.files else {
         bail!(
@@ -245,15 +260,14 @@ struct BinKey {
 
 impl BinKeys {
     fn of(table: &Table) -> Result<Self> {
-        let col = |name| table.column(name);
         Ok(Self {
-            case: col("case")?,
-            order: col("order")?,
-            hemisphere: col("hemisphere")?,
-            channel: table.column("channel").ok(),
-            cos_lo: col("cos_lo")?,
-            cos_hi: col("cos_hi")?,
-            phi_lo: col("phi_lo_deg")?,
+            case: table.column(schema::CASE)?,
+            order: table.column(schema::ORDER)?,
+            hemisphere: table.column(schema::HEMISPHERE)?,
+            channel: table.optional(schema::CHANNEL),
+            cos_lo: table.column(schema::COS_LO)?,
+            cos_hi: table.column(schema::COS_HI)?,
+            phi_lo: table.column(schema::PHI_LO_DEG)?,
         })
     }
 
@@ -290,33 +304,40 @@ fn lobe_rows(shape: &Shape, hemispheres: usize, slots: usize) -> usize {
     slots.saturating_mul(hemispheres * shape.grid.bins() * shape.channels)
 }
 
-/// Checks that `lobes.csv` has every case, slot, hemisphere, channel and bin exactly once, with
-/// finite non-negative energies and BSDF values. Columns are found by name; others are allowed.
-fn check_lobes(path: &Path, shape: &Shape) -> Result<()> {
+/// Reads the measured lobes of `lobes.csv` once it is checked to have every case, slot,
+/// hemisphere, channel and bin exactly once, with finite non-negative energies and BSDF
+/// values. Columns are found by name; others are allowed.
+fn read_lobes(path: &Path, shape: &Shape) -> Result<Lobes> {
     let table = Table::read(path)?;
     let keys = BinKeys::of(&table)?;
-    let values = ["energy", "energy_stderr", "bsdf", "bsdf_stderr"].map(|n| table.column(n).map(|c| (n, c)));
+    let [energy, energy_stderr, bsdf, bsdf_stderr] =
+        [schema::ENERGY, schema::ENERGY_STDERR, schema::BSDF, schema::BSDF_STDERR]
+            .map(|c| table.column(c).map(|i| (c, i)));
+    let values = [energy?, energy_stderr?, bsdf?, bsdf_stderr?];
     let (offsets, mut seen) = shape.rows(&table, |hemispheres, slots| lobe_rows(shape, hemispheres, slots))?;
+    let mut out = Lobes::default();
     for (line, r) in table.records.iter().enumerate() {
         let at = || format!("{} line {}", path.display(), line + 2);
         let key = keys.key(r, shape, &offsets, &at)?;
-        for v in &values {
-            let (name, column) = v.as_ref().map_err(|e| anyhow::anyhow!("{e}"))?;
-            number(r, *column, name, true, &at)?;
-        }
+        let [energy, energy_stderr, bsdf, bsdf_stderr] = values.map(|(c, i)| number(r, i, c.name, true, &at));
+        let bins = out.lobes.entry(key.lobe).or_insert_with(|| vec![BinValue::default(); shape.grid.bins()]);
+        bins[key.bin] =
+            BinValue { energy: energy?, energy_stderr: energy_stderr?, bsdf: bsdf?, bsdf_stderr: bsdf_stderr? };
         mark(&mut seen, key.row, &at)?;
     }
-    complete(&seen, path, |k| format!("row {k} in the run's order"))
+    complete(&seen, path, |k| format!("row {k} in the run's order"))?;
+    Ok(out)
 }
 
-/// The models of `models.csv`: each column `<name>` with a column `<name>_stderr`, as
-/// `(name, energy column, standard error column)` in the order of the header.
+/// The models of `models.csv`: each column `<name>` with a column `<name>_stderr`
+/// ([`schema::MODELS`]), as `(name, energy column, standard error column)` in the order of the
+/// header.
 fn model_columns(headers: &csv::StringRecord) -> Vec<(String, usize, usize)> {
     headers
         .iter()
         .enumerate()
         .filter_map(|(i, name)| {
-            let stderr = format!("{name}_stderr");
+            let stderr = format!("{name}{}", schema::STDERR_SUFFIX);
             headers.iter().position(|h| h == stderr).map(|j| (name.to_string(), i, j))
         })
         .collect()
@@ -377,10 +398,11 @@ fn bin_of(grid: Grid, cos_lo: f64, cos_hi: f64, phi_lo_deg: f64) -> Option<(usiz
 /// finite non-negative standard errors and VOVs.
 fn check_summary(path: &Path, shape: &Shape) -> Result<()> {
     let table = Table::read(path)?;
-    let col = |name| table.column(name);
-    let (case_c, order_c, hemi_c, paths_c) = (col("case")?, col("order")?, col("hemisphere")?, col("paths")?);
-    let (albedo_c, stderr_c, vov_c) = (col("albedo")?, col("albedo_stderr")?, col("albedo_vov")?);
-    let channel_c = table.column("channel").ok();
+    let col = |c| table.column(c);
+    let (case_c, order_c, hemi_c, paths_c) =
+        (col(schema::CASE)?, col(schema::ORDER)?, col(schema::SUMMARY_ROW)?, col(schema::PATHS)?);
+    let (albedo_c, stderr_c, vov_c) = (col(schema::ALBEDO)?, col(schema::ALBEDO_STDERR)?, col(schema::ALBEDO_VOV)?);
+    let channel_c = table.optional(schema::CHANNEL);
     let channels = shape.channels;
     // Per case: slots x hemispheres albedo rows, then absorbed and lost, each per channel.
     let (offsets, mut seen) = shape.rows(&table, |hemispheres, slots| {
@@ -441,60 +463,6 @@ impl Lobes {
     }
 }
 
-#[derive(Deserialize)]
-struct BinRow {
-    case: usize,
-    order: usize,
-    hemisphere: String,
-    #[serde(default)]
-    channel: Option<String>,
-    cos_lo: f64,
-    cos_hi: f64,
-    phi_lo_deg: f64,
-    energy: f64,
-    energy_stderr: f64,
-    bsdf: f64,
-    bsdf_stderr: f64,
-}
-
-fn channel_index(channel: &Option<String>) -> usize {
-    match channel.as_deref() {
-        Some("g") => 1,
-        Some("b") => 2,
-        _ => 0,
-    }
-}
-
-/// Reads the measured lobes of `lobes.csv`.
-fn read_bins(path: &Path, grid: Grid) -> Result<Lobes> {
-    let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let mut out = Lobes::default();
-    for row in reader.deserialize() {
-        let row: BinRow = row.with_context(|| format!("{}: bad row", path.display()))?;
-        let values = [row.cos_lo, row.cos_hi, row.phi_lo_deg, row.energy, row.energy_stderr, row.bsdf, row.bsdf_stderr];
-        if values.iter().any(|v| !v.is_finite()) {
-            bail!("{}: a bin of case {} with a value that is not finite", path.display(), row.case);
-        }
-        // |cos| of the bin's centre finds its cos index in either hemisphere.
-        let ic = ((0.5 * (row.cos_lo + row.cos_hi)).abs() * grid.cos_bins as f64) as usize;
-        let ip = (row.phi_lo_deg / 360.0 * grid.phi_bins as f64).round() as usize;
-        if ic >= grid.cos_bins || ip >= grid.phi_bins {
-            bail!("{}: a bin outside the run's {} x {} grid", path.display(), grid.cos_bins, grid.phi_bins);
-        }
-        let bins = out
-            .lobes
-            .entry((row.case, row.order, row.hemisphere.clone(), channel_index(&row.channel)))
-            .or_insert_with(|| vec![BinValue::default(); grid.bins()]);
-        bins[ic * grid.phi_bins + ip] = BinValue {
-            energy: row.energy,
-            energy_stderr: row.energy_stderr,
-            bsdf: row.bsdf,
-            bsdf_stderr: row.bsdf_stderr,
-        };
-    }
-    Ok(out)
-}
-
 /// One row of `summary.csv`: an albedo (or the absorbed or lost energy).
 #[derive(Clone, Debug, Deserialize)]
 pub struct SummaryRow {
@@ -534,7 +502,7 @@ impl RunDir {
         if run.cases.len() != cases.len() {
             bail!(
                 "{}: {} cases recorded, the config has {}",
-                path.join("run.json").display(),
+                path.join(schema::RUN_JSON).display(),
                 run.cases.len(),
                 cases.len()
             );
@@ -543,14 +511,14 @@ impl RunDir {
         let slots: Vec<usize> = run.cases.iter().map(|c| c.energy.highest_order.saturating_add(1)).collect();
         let run = Self { path: path.to_path_buf(), config, cases, grid, slots, _lock: lock };
         let shape = run.shape();
-        check_lobes(&path.join(TABLES[0]), &shape)?;
+        read_lobes(&path.join(TABLES[0]), &shape)?;
         check_summary(&path.join(TABLES[1]), &shape)?;
         Ok(run)
     }
 
     /// The measured lobes of `lobes.csv`.
     pub fn measured(&self) -> Result<Lobes> {
-        read_bins(&self.path.join("lobes.csv"), self.grid)
+        read_lobes(&self.path.join(schema::LOBES.file), &self.shape())
     }
 
     /// The model lobes of `models.csv` per model name (its columns `<name>` with a
@@ -558,7 +526,7 @@ impl RunDir {
     /// of `lobes.csv` in its order, each model's two cells both empty or both finite numbers
     /// >= 0. Empty if `compare` has not run.
     pub fn models(&self) -> Result<HashMap<String, Lobes>> {
-        let path = self.path.join("models.csv");
+        let path = self.path.join(schema::MODELS.file);
         if !path.exists() {
             return Ok(HashMap::new());
         }
@@ -584,7 +552,7 @@ impl RunDir {
 
     /// The rows of `summary.csv`.
     pub fn summary(&self) -> Result<Vec<SummaryRow>> {
-        let path = self.path.join("summary.csv");
+        let path = self.path.join(schema::SUMMARY.file);
         let mut reader = csv::Reader::from_path(&path).with_context(|| format!("cannot read {}", path.display()))?;
         reader.deserialize().map(|r| r.with_context(|| format!("{}: bad row", path.display()))).collect()
     }

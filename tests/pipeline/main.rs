@@ -10,4 +10,5 @@ mod determinism;
 mod first_use;
 mod resume;
 mod run_dir;
+mod schema;
 mod shards;

@@ -14,6 +14,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyTuple};
 use smithwalk::engine::detector::{Detector, Grid};
 use smithwalk::engine::run::{CaseResult, Estimator, Shard};
+use smithwalk::io::schema::{self, Column};
 use smithwalk::setup::config::{Config, ConfigError, Model};
 use smithwalk::{RunOptions, Simulation};
 
@@ -179,7 +180,7 @@ impl BinArrays {
             dict.set_item(name, PyArray1::from_vec(py, values).reshape(shape.clone())?)?;
         }
         if let Some(count) = self.count {
-            dict.set_item("count", PyArray1::from_vec(py, count).reshape(shape)?)?;
+            dict.set_item(schema::COUNT.name, PyArray1::from_vec(py, count).reshape(shape)?)?;
         }
         Ok(dict)
     }
@@ -192,7 +193,8 @@ fn shape(cases: usize, orders: usize, grid: Grid, channels: Option<usize>) -> Ve
     shape
 }
 
-const MEASURED: [&str; 4] = ["energy", "energy_stderr", "bsdf", "bsdf_stderr"];
+/// The measured values per bin, named as their columns of `lobes.csv`.
+const MEASURED: [&str; 4] = [schema::ENERGY.name, schema::ENERGY_STDERR.name, schema::BSDF.name, schema::BSDF_STDERR.name];
 
 /// Copies one case's detector into the arrays: the same means, standard errors, counts and
 /// projected solid angles that `lobes.csv` is written from.
@@ -289,21 +291,21 @@ struct BinColumns {
 
 impl BinColumns {
     fn of(headers: &csv::StringRecord) -> anyhow::Result<Self> {
-        let find = |name: &str| headers.iter().position(|h| h == name);
-        let need = |name: &str| find(name).with_context(|| format!("no column {name}"));
-        let values = ["energy", "energy_stderr", "bsdf", "bsdf_stderr"]
+        let find = |c: Column| headers.iter().position(|h| h == c.name);
+        let need = |c: Column| find(c).with_context(|| format!("no column {}", c.name));
+        let values = [schema::ENERGY, schema::ENERGY_STDERR, schema::BSDF, schema::BSDF_STDERR]
             .into_iter()
-            .filter_map(|name| find(name).map(|i| (name, i)))
+            .filter_map(|c| find(c).map(|i| (c.name, i)))
             .collect();
         Ok(Self {
-            case: need("case")?,
-            order: need("order")?,
-            hemisphere: need("hemisphere")?,
-            channel: find("channel"),
-            cos_lo: need("cos_lo")?,
-            cos_hi: need("cos_hi")?,
-            phi_lo: need("phi_lo_deg")?,
-            count: find("count"),
+            case: need(schema::CASE)?,
+            order: need(schema::ORDER)?,
+            hemisphere: need(schema::HEMISPHERE)?,
+            channel: find(schema::CHANNEL),
+            cos_lo: need(schema::COS_LO)?,
+            cos_hi: need(schema::COS_HI)?,
+            phi_lo: need(schema::PHI_LO_DEG)?,
+            count: find(schema::COUNT),
             values,
         })
     }
@@ -398,7 +400,7 @@ fn read_lobes<'py>(
 /// the run's order slots; lobes the model does not give are zero.
 #[pyfunction]
 fn read_models<'py>(py: Python<'py>, dir: PathBuf) -> PyResult<Bound<'py, PyDict>> {
-    const MODEL: [&str; 3] = ["energy", "energy_stderr", "bsdf"];
+    const MODEL: [&str; 3] = [schema::ENERGY.name, schema::ENERGY_STDERR.name, schema::BSDF.name];
     let parsed = py.detach(|| -> anyhow::Result<_> {
         let run = smithwalk::io::rundir::RunDir::open(&dir)?;
         let orders = run.slots.iter().copied().max().unwrap_or(1);
@@ -481,6 +483,21 @@ fn write_files(py: Python<'_>, dir: PathBuf, files: Vec<(String, Vec<u8>)>) -> P
     .map_err(|e| PyOSError::new_err(message(e)))
 }
 
+/// The run directory's tables ([`smithwalk::io::schema`]): per file name its columns in order,
+/// each as `(name, unit, meaning)`; `channel` is written by RGB runs only, and `models.csv`'s
+/// `<model>` and `<model>_stderr` stand for one pair of columns per model compared.
+#[pyfunction]
+fn columns() -> BTreeMap<&'static str, Vec<(&'static str, &'static str, &'static str)>> {
+    schema::TABLES.iter().map(|t| (t.file, t.columns.iter().map(|c| (c.name, c.unit, c.meaning)).collect())).collect()
+}
+
+/// The files of a run directory: `(written by a run, written by compare)`, each set written
+/// atomically.
+#[pyfunction]
+fn files() -> (Vec<&'static str>, Vec<&'static str>) {
+    (schema::RUN_FILES.to_vec(), schema::COMPARE_FILES.to_vec())
+}
+
 /// The names of the comparison models, in the command line's order.
 #[pyfunction]
 fn model_names() -> Vec<&'static str> {
@@ -499,5 +516,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(write_files, m)?)?;
     m.add_function(wrap_pyfunction!(model_names, m)?)?;
+    m.add_function(wrap_pyfunction!(columns, m)?)?;
+    m.add_function(wrap_pyfunction!(files, m)?)?;
     Ok(())
 }

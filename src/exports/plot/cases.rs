@@ -2,8 +2,9 @@
 
 use std::collections::BTreeMap;
 
-use crate::io::output::{CASE_COLUMNS, case_fields};
+use crate::io::output::case_fields;
 use crate::io::rundir::RunDir;
+use crate::io::schema::CASE_COLUMNS;
 use crate::setup::cases::Case;
 
 /// The case fields without the case index and the columns `swept`, which identify a group of
@@ -35,7 +36,7 @@ pub(super) fn varying(cases: &[Case]) -> Vec<usize> {
 
 /// How a case column reads in captions: a name and the value (`α_x = 0.5`, `θ_i = 30°`).
 fn pretty_field(column: usize, value: &str) -> String {
-    match CASE_COLUMNS[column] {
+    match CASE_COLUMNS[column].name {
         "alpha_x" => format!("α_x = {value}"),
         "alpha_y" => format!("α_y = {value}"),
         "theta_i_deg" => format!("θ_i = {:.1}°", value.parse::<f64>().unwrap_or(f64::NAN)),
@@ -76,7 +77,7 @@ pub(super) fn surface_label(run: &RunDir, case: &Case) -> String {
     let mut label = format!("{}, {alpha}, {}", fields[1].to_uppercase(), fields[7]);
     for (column, default) in [(5, "exact"), (6, "vndf")] {
         if fields[column] != default {
-            label.push_str(&format!(", {} {}", CASE_COLUMNS[column], fields[column]));
+            label.push_str(&format!(", {} {}", CASE_COLUMNS[column].name, fields[column]));
         }
     }
     if fields[10] != "outside" || varying(&run.cases).contains(&10) {

@@ -13,8 +13,9 @@ use super::cases::{describe, pretty_fields, surface_label, varying};
 use super::rows::slot_label;
 use super::selection::Selection;
 use crate::analysis::stats::sidak;
-use crate::io::output::{CASE_COLUMNS, case_fields};
+use crate::io::output::case_fields;
 use crate::io::rundir::{Lobes, RunDir, Table};
+use crate::io::schema::{self, CASE_COLUMNS};
 use crate::setup::cases::Case;
 
 /// A figure drawn and the caption the report shows under it.
@@ -77,22 +78,28 @@ struct Comparison {
 }
 
 fn read_comparisons(run_dir: &Path) -> Result<Option<Vec<Comparison>>> {
-    let path = run_dir.join("compare.csv");
+    let path = run_dir.join(schema::COMPARE.file);
     if !path.exists() {
         return Ok(None);
     }
     let table = Table::read(&path)?;
-    let column = |name: &str| table.column(name);
-    let optional = |name: &str| table.headers.iter().position(|h| h == name);
-    let (case, model, order, hemisphere) = (column("case")?, column("model")?, column("order")?, column("hemisphere")?);
-    let (chi2, dof, p, rel_l1, diff) =
-        (column("chi2")?, column("dof")?, column("p_value")?, column("rel_l1")?, column("albedo_diff_se")?);
+    let column = |c| table.column(c);
+    let optional = |c| table.optional(c);
+    let (case, model, order, hemisphere) =
+        (column(schema::CASE)?, column(schema::MODEL)?, column(schema::ORDER)?, column(schema::HEMISPHERE)?);
+    let (chi2, dof, p, rel_l1, diff) = (
+        column(schema::CHI2)?,
+        column(schema::DOF)?,
+        column(schema::P_VALUE)?,
+        column(schema::REL_L1)?,
+        column(schema::ALBEDO_DIFF_SE)?,
+    );
     let (channel, folded, level, lobe_level, rejected) = (
-        optional("channel"),
-        optional("folded"),
-        optional("family_level"),
-        optional("lobe_level"),
-        optional("rejected"),
+        optional(schema::CHANNEL),
+        optional(schema::FOLDED),
+        optional(schema::FAMILY_LEVEL),
+        optional(schema::LOBE_LEVEL),
+        optional(schema::REJECTED),
     );
     let number = |r: &csv::StringRecord, c: usize| -> Result<f64> {
         r[c].parse().map_err(|_| {
@@ -253,7 +260,7 @@ pub(super) fn page(
         let _ = writeln!(html, "<h2>{}</h2>", escape(&surface_label(run, section.cases[0])));
         html.push_str("<table><tr><th>case</th>");
         for &c in &shown {
-            let _ = write!(html, "<th>{}</th>", CASE_COLUMNS[c]);
+            let _ = write!(html, "<th>{}</th>", CASE_COLUMNS[c].name);
         }
         html.push_str("</tr>\n");
         for case in &section.cases {

@@ -11,6 +11,8 @@ run(config, *, paths=None, seed=None, threads=None, progress=False)
     :class:`RunResult`.
 load(path)
     Read a run directory written by ``smithwalk run`` or :meth:`RunResult.save`.
+columns(file=None)
+    The columns of the run directory's tables: name, unit and meaning.
 
 Classes
 -------
@@ -38,7 +40,7 @@ import numpy as np
 
 from . import _native
 
-__all__ = ["run", "load", "RunResult", "Comparison", "MODELS", "HEMISPHERES", "CHANNELS"]
+__all__ = ["run", "load", "columns", "RunResult", "Comparison", "MODELS", "HEMISPHERES", "CHANNELS"]
 
 __version__ = _native.__version__
 
@@ -49,8 +51,34 @@ HEMISPHERES = ("R", "T")
 #: Labels of the channel axis of RGB runs.
 CHANNELS = ("r", "g", "b")
 
-_RUN_FILES = ("lobes.csv", "summary.csv", "run.json")
-_COMPARE_FILES = ("models.csv", "compare.csv")
+# The run directory's files and columns come from the extension (the crate's io::schema).
+_RUN_FILES, _COMPARE_FILES = _native.files()
+# What follows a model's name in its standard-error column of models.csv ("<model>_stderr").
+_STDERR = _native.columns()["models.csv"][-1][0].replace("<model>", "")
+
+
+def columns(file=None):
+    """The columns of the run directory's tables, as the command line writes them.
+
+    Parameters
+    ----------
+    file : str, optional
+        A table's file name (``"lobes.csv"``, ``"summary.csv"``, ``"models.csv"``,
+        ``"compare.csv"``); all tables when omitted.
+
+    Returns
+    -------
+    list of (name, unit, meaning), or dict of such lists per file name
+        Each table's columns in order. ``channel`` is written by RGB runs only; in
+        ``models.csv``, ``<model>`` and ``<model>_stderr`` stand for one pair of columns per
+        model compared.
+    """
+    tables = _native.columns()
+    if file is None:
+        return tables
+    if file not in tables:
+        raise ValueError(f"file = {file!r} is not allowed: one of {', '.join(tables)}")
+    return tables[file]
 
 
 def _config_source(config):
@@ -218,8 +246,8 @@ class RunResult:
         self.cos_edges, self.phi_edges_deg, self.projected_solid_angle = _native.grid(
             detector.get("cos_theta_bins", 32), detector.get("phi_bins", 64)
         )
-        for name in ("energy", "energy_stderr", "count", "bsdf", "bsdf_stderr"):
-            setattr(self, name, lobes[name])
+        for name, values in lobes.items():
+            setattr(self, name, values)
         slots = self.energy.shape[1]
         max_order = detector.get("max_order")
         self.folded = np.array([k == max_order for k in range(slots)])
@@ -428,4 +456,4 @@ def _model_names(models_csv: bytes):
     """The models of a ``models.csv``, in the order compared: each column ``<name>`` that has a
     column ``<name>_stderr``."""
     header = next(csv.reader([models_csv.split(b"\n", 1)[0].decode()]))
-    return [name for name in header if f"{name}_stderr" in header]
+    return [name for name in header if f"{name}{_STDERR}" in header]
