@@ -194,7 +194,8 @@ fn shape(cases: usize, orders: usize, grid: Grid, channels: Option<usize>) -> Ve
 }
 
 /// The measured values per bin, named as their columns of `lobes.csv`.
-const MEASURED: [&str; 4] = [schema::ENERGY.name, schema::ENERGY_STDERR.name, schema::BSDF.name, schema::BSDF_STDERR.name];
+const MEASURED: [&str; 4] =
+    [schema::ENERGY.name, schema::ENERGY_STDERR.name, schema::BSDF.name, schema::BSDF_STDERR.name];
 
 /// Copies one case's detector into the arrays: the same means, standard errors, counts and
 /// projected solid angles that `lobes.csv` is written from.

@@ -52,6 +52,24 @@ def test_shapes_dtypes_and_labels(mono):
     assert not mono.energy[:2, :, 1].any() and mono.energy[2:4, :, 1].any()
 
 
+def test_columns_are_the_ones_the_files_have(tmp_path):
+    # The schema comes from the extension (the crate's io::schema), not from a Python list: the
+    # header of every table a saved run and its comparison write is the schema's, in order.
+    result = smithwalk.run(MONO, paths=2000)
+    result.compare(["single"])
+    result.save(tmp_path / "run")
+    tables = smithwalk.columns()
+    assert set(tables) == {"lobes.csv", "summary.csv", "models.csv", "compare.csv"}
+    for file, columns in tables.items():
+        header = (tmp_path / "run" / file).read_text().split("\n", 1)[0].split(",")
+        names = [name for name, unit, meaning in columns if name != "channel"]
+        names = [n.replace("<model>", "single") for n in names]
+        assert header == names, file
+    assert all(meaning for _, _, meaning in smithwalk.columns("lobes.csv"))
+    with pytest.raises(ValueError, match="file = 'lobe.csv' is not allowed"):
+        smithwalk.columns("lobe.csv")
+
+
 def test_rgb_runs_have_a_channel_axis():
     r = smithwalk.run(RGB)
     assert r.channels == ("r", "g", "b")
