@@ -1,7 +1,7 @@
 //! The format of a run directory, in one place (docs/run-directory.md): every file smithwalk
 //! writes into it and, for each table, its columns in order with their units and meaning.
 //! Writers take their headers from here ([`TableSchema::header`]), readers find their columns
-//! through here ([`crate::io::rundir::Table::column`]), and the Python package asks the
+//! through here (`io::rundir`'s `Table::column`), and the Python package asks the
 //! extension for them (`smithwalk.columns()`), so that a column is named once.
 
 /// The version of the run directory's format, written to `run.json` as `format_version`.
