@@ -50,6 +50,11 @@ enum Command {
         /// directory, removed when the run finishes).
         #[arg(long, default_value_t = 10.0)]
         checkpoint_seconds: f64,
+        /// The most memory the run may plan to use, e.g. 8G or 512M (default: 80% of the memory
+        /// available to the process: the machine's, its cgroup's or its Slurm allocation's,
+        /// whichever is least). A run whose estimated peak exceeds it is refused before any work.
+        #[arg(long, value_name = "SIZE", value_parser = smithwalk::engine::resources::parse_size)]
+        max_memory: Option<u64>,
     },
     /// Combine the shard.bin files of all shards of a run into the run's tables, identical to
     /// those of the unsplit run.
@@ -190,8 +195,18 @@ fn main() -> ExitCode {
     let default_models =
         matches.subcommand_matches("compare").and_then(|m| m.value_source("models")) == Some(ValueSource::DefaultValue);
     let result = match cli.command {
-        Command::Run { config, paths, seed, threads, out, shard, resume, checkpoint_seconds } => {
-            commands::run::run(RunArgs { config, paths, seed, threads, out, shard, resume, checkpoint_seconds })
+        Command::Run { config, paths, seed, threads, out, shard, resume, checkpoint_seconds, max_memory } => {
+            commands::run::run(RunArgs {
+                config,
+                paths,
+                seed,
+                threads,
+                out,
+                shard,
+                resume,
+                checkpoint_seconds,
+                max_memory,
+            })
         }
         Command::Merge { shards, out } => commands::merge::merge(&shards, &out),
         Command::Compare { run_dir, models, paths, threads, level, fail_on_reject, external, albedo_table } => {

@@ -353,7 +353,7 @@ fn simulate_model(
     progress: bool,
 ) -> Result<Simulation> {
     let model_config = Config { seed, ..config.clone() };
-    let options = RunOptions { estimator, shard: Shard::WHOLE, threads, show_progress: progress };
+    let options = RunOptions { estimator, shard: Shard::WHOLE, threads, show_progress: progress, max_memory: None };
     crate::engine::simulate_from(&model_config, &options, None, &mut |_, _, _| Ok(()))
 }
 

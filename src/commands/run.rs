@@ -10,6 +10,7 @@ use crate::atomic::{lock_dir, prepare_dir};
 use crate::commands::options::{default_out, note_threads};
 use crate::commands::summary::{report, threads_text};
 use crate::engine::checkpoint::{self, Checkpointer};
+use crate::engine::resources::{check_resources, gigabytes, peak_memory};
 use crate::engine::run::{Estimator, Shard};
 use crate::engine::shard::write_shard;
 use crate::engine::{RunOptions, Simulation};
@@ -26,6 +27,8 @@ pub struct RunArgs {
     pub shard: Option<Shard>,
     pub resume: bool,
     pub checkpoint_seconds: f64,
+    /// `--max-memory`, in bytes.
+    pub max_memory: Option<u64>,
 }
 
 /// `smithwalk run`: walks the run (or its shard, or this MPI rank's share), writes its outputs
@@ -82,7 +85,9 @@ fn run_config(args: &RunArgs) -> Result<Config> {
     if let Some(s) = args.seed {
         config.seed = s;
     }
-    crate::engine::check_resources(&config, args.threads)?;
+    let (estimate, limit) = check_resources(&config, args.threads, args.max_memory)?;
+    let allowed = limit.map_or(String::new(), |l| format!(" of {} allowed ({})", gigabytes(l.bytes), l.source));
+    println!("memory: about {} at the peak{allowed}", gigabytes(estimate.bytes()));
     note_threads(args.threads);
     if !(args.checkpoint_seconds.is_finite() && args.checkpoint_seconds > 0.0) {
         bail!("`--checkpoint-seconds` = {} is not allowed: a positive number of seconds", args.checkpoint_seconds);
@@ -102,7 +107,13 @@ fn walk(
 ) -> Result<(Simulation, Checkpointer)> {
     let states = if args.resume { checkpoint::load(dir, config, shard)? } else { None };
     let mut checkpoints = Checkpointer::new(dir, Duration::from_secs_f64(args.checkpoint_seconds), config, shard)?;
-    let options = RunOptions { shard, threads: args.threads, show_progress, estimator: Estimator::Walk };
+    let options = RunOptions {
+        shard,
+        threads: args.threads,
+        show_progress,
+        estimator: Estimator::Walk,
+        max_memory: args.max_memory,
+    };
     let sim = crate::engine::simulate_from(config, &options, states, &mut |done, current, later| {
         checkpoints.after_round(done, current, later)
     })?;
@@ -118,6 +129,9 @@ fn finish_run(
     threads: Option<usize>,
 ) -> Result<()> {
     report(sim, config, written)?;
+    if let Some(peak) = peak_memory() {
+        println!("peak memory: {}", gigabytes(peak));
+    }
     if let Some(c) = &config.compare {
         let models =
             c.models.iter().map(|m| Model::parse(m).map_err(anyhow::Error::msg)).collect::<Result<Vec<_>>>()?;

@@ -7,6 +7,7 @@ pub mod checkpoint;
 pub mod detector;
 #[cfg(feature = "mpi")]
 pub mod ranks;
+pub mod resources;
 pub mod run;
 pub mod sealed;
 pub mod shard;
@@ -42,85 +43,8 @@ pub fn simulate_shard(
     threads: Option<usize>,
     show_progress: bool,
 ) -> Result<Simulation> {
-    let options = RunOptions { shard, threads, show_progress, estimator: Estimator::Walk };
+    let options = RunOptions { shard, threads, show_progress, estimator: Estimator::Walk, max_memory: None };
     simulate_from(config, &options, None, &mut |_, _, _| Ok(()))
-}
-
-/// The most worker threads a run may ask for. Outputs do not depend on the thread count, and
-/// starting many more threads than cores only costs time (`--threads 100000` took minutes).
-pub const MAX_THREADS: usize = 1024;
-
-/// Order slots assumed by the memory estimate when `detector.max_order` leaves the number of
-/// slots to the walk (slots are added as orders are seen).
-pub const ESTIMATED_SLOTS: usize = 16;
-
-/// Bytes per row of `lobes.csv` assumed by the memory estimate (rows of the shipped configs
-/// take 110 to 150 bytes).
-const CSV_ROW_BYTES: u64 = 160;
-
-/// Checks, before any work, that a run of `config` on `threads` threads can finish: the thread
-/// count is within [`MAX_THREADS`] and the estimated memory (detectors of every case and of
-/// the threads' rounds, and the text of `lobes.csv`) fits in the memory available now. The
-/// error names the fields to change.
-pub fn check_resources(config: &Config, threads: Option<usize>) -> Result<()> {
-    let threads = match threads {
-        Some(0) => anyhow::bail!("`--threads` = 0 is not allowed: at least 1 thread"),
-        Some(n) if n > MAX_THREADS => anyhow::bail!(
-            "`--threads` = {n} is not allowed: at most {MAX_THREADS} (outputs do not depend on the thread count;              this machine has {} cores)",
-            cores()
-        ),
-        Some(n) => n,
-        None => cores(),
-    };
-    let estimate = memory_estimate(config, threads);
-    if let Some(available) = available_memory()
-        && estimate > available
-    {
-        let d = &config.detector;
-        let slots =
-            d.max_order.map_or(format!("{ESTIMATED_SLOTS} order slots assumed"), |k| format!("{} order slots", k + 1));
-        anyhow::bail!(
-            "the run needs about {:.1} GB but {:.1} GB of memory are available: {} cases x {} x {} bins              (detector.cos_theta_bins x detector.phi_bins) x {slots} (detector.max_order) x {} channels,              held for every case and {threads} threads (--threads), plus lobes.csv; reduce the bins, set or              lower detector.max_order, sweep fewer cases or split the sweep into several configs",
-            estimate as f64 / 1e9,
-            available as f64 / 1e9,
-            config.cases(),
-            d.cos_theta_bins,
-            d.phi_bins,
-            if config.is_rgb() { 3 } else { 1 }
-        );
-    }
-    Ok(())
-}
-
-fn cores() -> usize {
-    std::thread::available_parallelism().map_or(1, usize::from)
-}
-
-/// Bytes a run of `config` on `threads` threads is estimated to hold at its peak (§9.2 tallies,
-/// both hemispheres of every order slot; the text of lobes.csv once).
-pub fn memory_estimate(config: &Config, threads: usize) -> u64 {
-    let d = &config.detector;
-    let (tally, channels) = if config.is_rgb() {
-        (std::mem::size_of::<detector::Tally<3>>(), 3)
-    } else {
-        (std::mem::size_of::<detector::Tally<1>>(), 1)
-    };
-    let slots = d.max_order.map_or(ESTIMATED_SLOTS, |k| k as usize + 1) as u64;
-    let bins = (d.cos_theta_bins * d.phi_bins) as u64;
-    let cases = config.cases();
-    let detector = slots * 2 * bins * tally as u64;
-    // Every case's state, and per thread the part of a round it walks and one waiting round.
-    let held = (cases + 2 * threads as u64).saturating_mul(detector);
-    let rows = cases.saturating_mul(slots * 2 * bins * channels);
-    held.saturating_add(rows.saturating_mul(CSV_ROW_BYTES))
-}
-
-/// `MemAvailable` of `/proc/meminfo` in bytes, where there is one.
-fn available_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
 }
 
 /// Called after every round with (finished cases, the current case, cases not started).
@@ -133,6 +57,9 @@ pub struct RunOptions {
     pub shard: Shard,
     pub threads: Option<usize>,
     pub show_progress: bool,
+    /// The memory the run may plan to use (`--max-memory`); `None`: a share of what the
+    /// process may use ([`resources::MemoryLimit::of`]).
+    pub max_memory: Option<u64>,
 }
 
 /// Runs a simulation from saved case states (a resumed checkpoint) or from scratch, calling
@@ -144,7 +71,7 @@ pub fn simulate_from(
     states: Option<Vec<CaseState>>,
     after_round: &mut RoundHook<'_>,
 ) -> Result<Simulation> {
-    check_resources(config, options.threads)?;
+    resources::check_resources(config, options.threads, options.max_memory)?;
     let cases = crate::setup::cases::expand(config)?;
     let settings =
         RunSettings { shard: options.shard, estimator: options.estimator, ..RunSettings::from_config(config) };

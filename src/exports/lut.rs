@@ -359,8 +359,13 @@ impl Lut {
 pub fn build(config: &LutConfig, threads: Option<usize>, show_progress: bool) -> Result<Lut> {
     config.validate()?;
     let run = config.run_config();
-    let options =
-        RunOptions { estimator: Estimator::Walk, shard: crate::engine::run::Shard::WHOLE, threads, show_progress };
+    let options = RunOptions {
+        estimator: Estimator::Walk,
+        shard: crate::engine::run::Shard::WHOLE,
+        threads,
+        show_progress,
+        max_memory: None,
+    };
     let sim = crate::engine::simulate_from(&run, &options, None, &mut |_, _, _| Ok(()))?;
     Ok(assemble(config, &sim))
 }

@@ -509,6 +509,17 @@ impl RunDir {
         }
         let grid = Grid { cos_bins: config.detector.cos_theta_bins, phi_bins: config.detector.phi_bins };
         let slots: Vec<usize> = run.cases.iter().map(|c| c.energy.highest_order.saturating_add(1)).collect();
+        if let (Some(max), Some(worst)) =
+            (config.detector.max_order, run.cases.iter().map(|c| c.energy.highest_order).max())
+            && worst > max as usize
+        {
+            bail!(
+                "{}: a case reached order {worst}, beyond detector.max_order = {max} (a run written before max_order \
+                 defaulted to {}); rerun the config",
+                path.join(schema::RUN_JSON).display(),
+                crate::setup::config::DEFAULT_MAX_ORDER
+            );
+        }
         let run = Self { path: path.to_path_buf(), config, cases, grid, slots, _lock: lock };
         let shape = run.shape();
         read_lobes(&path.join(TABLES[0]), &shape)?;

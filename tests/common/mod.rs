@@ -72,6 +72,7 @@ pub fn simulate_with(toml: &str, estimator: smithwalk::engine::run::Estimator) -
         shard: smithwalk::engine::run::Shard::WHOLE,
         threads: Some(2),
         show_progress: false,
+        max_memory: None,
     };
     smithwalk::simulate_from(&config, &options, None, &mut |_, _, _| Ok(())).expect("simulation runs")
 }

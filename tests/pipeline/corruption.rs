@@ -100,8 +100,13 @@ fn every_byte_flip_of_a_checkpoint_is_refused_or_harmless() {
     // Two rounds of chunks per case, so the checkpoint is taken in the middle of the run.
     let config = Config::parse(&CONFIG.replace("40_000", "600_000")).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let options =
-        RunOptions { estimator: Estimator::Walk, shard: Shard::WHOLE, threads: Some(2), show_progress: false };
+    let options = RunOptions {
+        estimator: Estimator::Walk,
+        shard: Shard::WHOLE,
+        threads: Some(2),
+        show_progress: false,
+        max_memory: None,
+    };
     let expected = tables(&smithwalk::simulate(&config, Some(2), false).unwrap());
     let mut checkpoints = Checkpointer::new(dir.path(), std::time::Duration::ZERO, &config, Shard::WHOLE).unwrap();
     // A run killed after its first checkpoint: the hook stops it.

@@ -130,7 +130,13 @@ fn run(
     if threads == Some(0) {
         return Err(PyValueError::new_err("`threads` = 0 is not allowed: at least 1 thread"));
     }
-    let options = RunOptions { shard: Shard::WHOLE, threads, show_progress: progress, estimator: Estimator::Walk };
+    let options = RunOptions {
+        shard: Shard::WHOLE,
+        threads,
+        show_progress: progress,
+        estimator: Estimator::Walk,
+        max_memory: None,
+    };
     let mut signal: Option<PyErr> = None;
     let sim = py.detach(|| {
         smithwalk::simulate_from(&config, &options, None, &mut |_, _, _| {

@@ -126,6 +126,12 @@ fn loss_index(loss: Loss) -> usize {
 }
 
 impl<const C: usize> Detector<C> {
+    /// Bytes per bin of one hemisphere of one order slot of a detector that walks: the bin's
+    /// tally, its sums over the chunk and its count of photons of weight 1 (what
+    /// [`crate::engine::resources::MemoryEstimate`] counts).
+    pub fn bytes_per_bin() -> u64 {
+        (std::mem::size_of::<Tally<C>>() + std::mem::size_of::<ChunkBin<C>>() + std::mem::size_of::<u32>()) as u64
+    }
     /// A detector for light arriving from `wi` (towards the light).
     pub fn new(grid: Grid, wi: DVec3, max_order: Option<u32>) -> Self {
         let horizontal = wi.x.hypot(wi.y);

@@ -21,7 +21,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 pub use compare::{CompareConfig, Model};
-pub use detector::DetectorConfig;
+pub use detector::{DEFAULT_MAX_ORDER, DetectorConfig};
 pub use energy::EnergyConfig;
 pub use error::ConfigError;
 pub(crate) use error::invalid;
@@ -187,7 +187,7 @@ impl Config {
             return Err(invalid("detector.phi_bins", d.phi_bins, "an integer from 1 to 4096"));
         }
         if d.max_order == Some(0) {
-            return Err(invalid("detector.max_order", 0, "an order >= 1, or leave it out to keep every order"));
+            return Err(invalid("detector.max_order", 0, "an order >= 1 (left out: 64)"));
         }
         if let Some(p) = &self.precision {
             p.validate()?;
