@@ -124,10 +124,28 @@ fn type_errors_say_what_is_allowed_in_user_terms() {
     }
 }
 
+/// Questions a tool should refuse (issue 36 item 6): a `[compare]` table that names no model
+/// would test nothing and pass; an azimuth beyond one turn either way is a typo.
+#[test]
+fn an_empty_model_list_and_an_azimuth_beyond_a_turn_are_refused() {
+    let with = |from: &str, to: &str| BASE.replace(from, to);
+    let cases = [
+        (format!("{BASE}[compare]\nmodels = []\n"), "`compare.models` = []", "at least one model"),
+        (with("theta_deg = 30", "theta_deg = 30\nphi_deg = 1e300"), "`incident.phi_deg` = ", "in [-360, 360]"),
+        (with("theta_deg = 30", "theta_deg = 30\nphi_deg = [0, -360.5]"), "`incident.phi_deg` = -360.5", "[-360, 360]"),
+    ];
+    for (toml, value, allowed) in cases {
+        let e = error_of(&toml);
+        assert!(e.contains(value) && e.contains(allowed), "{e}");
+    }
+    // The bounds themselves are azimuths.
+    assert!(Config::parse(&with("theta_deg = 30", "theta_deg = 30\nphi_deg = [-360, 360]")).is_ok());
+}
+
 #[test]
 fn a_huge_sweep_is_refused_before_it_is_expanded() {
     let thetas: Vec<String> = (0..1000).map(|i| format!("{}", i as f64 * 0.09)).collect();
-    let phis: Vec<String> = (0..1001).map(|i| i.to_string()).collect();
+    let phis: Vec<String> = (0..1001).map(|i| format!("{}", i as f64 * 0.3)).collect();
     let toml =
         BASE.replace("theta_deg = 30", &format!("theta_deg = [{}]\nphi_deg = [{}]", thetas.join(","), phis.join(",")));
     let e = error_of(&toml);
