@@ -140,6 +140,9 @@ pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Op
 pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome> {
     options.validate()?;
     let run = RunDir::open(run_dir)?;
+    if let Some(reason) = options.models.iter().find_map(|m| m.refuses_threshold(run.config.energy.threshold)) {
+        bail!("`--models`: {reason}");
+    }
     let external = options.external.as_deref().map(|path| crate::analysis::external::read(path, &run)).transpose()?;
     let models = [&options.models[..], if external.is_some() { &[Model::External][..] } else { &[] }].concat();
     let albedo_table = options.albedo_table.as_deref().map(AlbedoTable::read).transpose()?;

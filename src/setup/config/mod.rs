@@ -211,7 +211,10 @@ impl Config {
                 ));
             }
             for m in &c.models {
-                Model::parse(m).map_err(|allowed| invalid("compare.models", format!("{m:?}"), allowed))?;
+                let model = Model::parse(m).map_err(|allowed| invalid("compare.models", format!("{m:?}"), allowed))?;
+                if let Some(reason) = model.refuses_threshold(self.energy.threshold) {
+                    return Err(invalid("compare.models", format!("{m:?}"), reason));
+                }
             }
             if let Some(p) = c.paths
                 && !(2..=MAX_PATHS).contains(&p)
