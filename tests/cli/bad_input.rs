@@ -124,10 +124,55 @@ fn type_errors_say_what_is_allowed_in_user_terms() {
     }
 }
 
+/// Questions a tool should refuse (issue 36 item 6): a `[compare]` table that names no model
+/// would test nothing and pass; an azimuth beyond one turn either way is a typo.
+#[test]
+fn an_empty_model_list_and_an_azimuth_beyond_a_turn_are_refused() {
+    let with = |from: &str, to: &str| BASE.replace(from, to);
+    let cases = [
+        (format!("{BASE}[compare]\nmodels = []\n"), "`compare.models` = []", "at least one model"),
+        (with("theta_deg = 30", "theta_deg = 30\nphi_deg = 1e300"), "`incident.phi_deg` = ", "in [-360, 360]"),
+        (with("theta_deg = 30", "theta_deg = 30\nphi_deg = [0, -360.5]"), "`incident.phi_deg` = -360.5", "[-360, 360]"),
+    ];
+    for (toml, value, allowed) in cases {
+        let e = error_of(&toml);
+        assert!(e.contains(value) && e.contains(allowed), "{e}");
+    }
+    // The exact position-free chain ends only by Russian roulette: no threshold, no end.
+    let endless =
+        format!("{BASE}[energy]\nsplit = false\nthreshold = 0\n[compare]\nmodels = [\"exact-position-free\"]\n");
+    let e = error_of(&endless);
+    assert!(e.contains("`compare.models` = \"exact-position-free\"") && e.contains("energy.threshold > 0"), "{e}");
+    // The bounds themselves are azimuths.
+    assert!(Config::parse(&with("theta_deg = 30", "theta_deg = 30\nphi_deg = [-360, 360]")).is_ok());
+}
+
+/// `compare --models exact-position-free` on a run walked with no roulette threshold is refused
+/// before any work, with one line, and writes no comparison.
+#[test]
+fn compare_refuses_the_position_free_chain_on_a_run_without_roulette() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("c.toml");
+    std::fs::write(&config, format!("{BASE}[energy]\nsplit = false\nthreshold = 0\n")).unwrap();
+    let out_dir = dir.path().join("out");
+    let smithwalk = || Command::new(env!("CARGO_BIN_EXE_smithwalk"));
+    let run = smithwalk()
+        .args(["run", config.to_str().unwrap(), "--paths", "100", "--out", out_dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let out =
+        smithwalk().args(["compare", out_dir.to_str().unwrap(), "--models", "exact-position-free"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("exact-position-free needs energy.threshold > 0") && stderr.contains("is 0"), "{stderr}");
+    assert!(!out_dir.join("models.csv").exists() && !out_dir.join("compare.csv").exists());
+}
+
 #[test]
 fn a_huge_sweep_is_refused_before_it_is_expanded() {
     let thetas: Vec<String> = (0..1000).map(|i| format!("{}", i as f64 * 0.09)).collect();
-    let phis: Vec<String> = (0..1001).map(|i| i.to_string()).collect();
+    let phis: Vec<String> = (0..1001).map(|i| format!("{}", i as f64 * 0.3)).collect();
     let toml =
         BASE.replace("theta_deg = 30", &format!("theta_deg = [{}]\nphi_deg = [{}]", thetas.join(","), phis.join(",")));
     let e = error_of(&toml);

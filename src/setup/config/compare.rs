@@ -50,6 +50,20 @@ impl Model {
         }
     }
 
+    /// Why the model cannot judge a run walked with Russian roulette below `threshold`
+    /// (`energy.threshold`), if it cannot: the exact position-free chain (§7.1) ends only by
+    /// that roulette once its weight is small, so with no threshold its chains run on through
+    /// weights that no longer change the lobes.
+    pub fn refuses_threshold(self, threshold: f64) -> Option<String> {
+        (self == Model::ExactPositionFree && threshold <= 0.0).then(|| {
+            format!(
+                "{} needs energy.threshold > 0 (its chains end only by Russian roulette below it), \
+                 and the run's is {threshold}: walk it with a threshold (0.1 is the default)",
+                self.name()
+            )
+        })
+    }
+
     pub fn parse(text: &str) -> Result<Self, String> {
         Model::ALL.into_iter().find(|m| m.name() == text).ok_or_else(|| {
             let names: Vec<&str> = Model::ALL.iter().map(|m| m.name()).collect();

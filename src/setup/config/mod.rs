@@ -164,9 +164,10 @@ impl Config {
             }
         }
         non_empty("incident.phi_deg", &i.phi_deg)?;
+        // One turn either way names every azimuth; a larger one (1e300) is a typo, not a direction.
         for p in i.phi_deg.values() {
-            if !p.is_finite() {
-                return Err(invalid("incident.phi_deg", p, "a finite azimuth in degrees"));
+            if !(p.is_finite() && (-360.0..=360.0).contains(&p)) {
+                return Err(invalid("incident.phi_deg", p, "an azimuth in degrees in [-360, 360]"));
             }
         }
         non_empty("incident.side", &i.side)?;
@@ -202,8 +203,18 @@ impl Config {
             }
         }
         if let Some(c) = &self.compare {
+            if c.models.is_empty() {
+                return Err(invalid(
+                    "compare.models",
+                    "[]",
+                    "at least one model, e.g. [\"single\"] (leave `[compare]` out to compare with none)",
+                ));
+            }
             for m in &c.models {
-                Model::parse(m).map_err(|allowed| invalid("compare.models", format!("{m:?}"), allowed))?;
+                let model = Model::parse(m).map_err(|allowed| invalid("compare.models", format!("{m:?}"), allowed))?;
+                if let Some(reason) = model.refuses_threshold(self.energy.threshold) {
+                    return Err(invalid("compare.models", format!("{m:?}"), reason));
+                }
             }
             if let Some(p) = c.paths
                 && !(2..=MAX_PATHS).contains(&p)
