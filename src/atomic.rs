@@ -84,6 +84,8 @@ pub fn write_file_atomically(out: &Path, bytes: Vec<u8>) -> Result<PathBuf> {
         .file_name()
         .and_then(|n| n.to_str())
         .with_context(|| format!("the output {} needs a file name", out.display()))?;
+    // Checked before the directory is prepared, so that nothing is written beside a device.
+    refuse_special(out)?;
     prepare_dir(dir)?;
     let written = write_atomically(dir, &[(name, bytes)])?;
     Ok(written.into_iter().next().expect("one file"))
@@ -92,6 +94,9 @@ pub fn write_file_atomically(out: &Path, bytes: Vec<u8>) -> Result<PathBuf> {
 /// Writes all files: every one goes to a temporary file first; only when all are complete are
 /// they renamed into place, so a failure leaves no partial or corrupt output.
 pub fn write_atomically(dir: &Path, files: &[(&str, Vec<u8>)]) -> Result<Vec<PathBuf>> {
+    for (file, _) in files {
+        refuse_special(&dir.join(file))?;
+    }
     let mut staged = Vec::new();
     for (file, bytes) in files {
         let mut tmp = temp_file(dir).with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
@@ -102,10 +107,49 @@ pub fn write_atomically(dir: &Path, files: &[(&str, Vec<u8>)]) -> Result<Vec<Pat
     }
     let mut written = Vec::new();
     for (tmp, path) in staged {
+        // Checked again just before the rename, which would replace whatever is there.
+        refuse_special(&path)?;
         tmp.persist(&path).with_context(|| format!("cannot rename into {}", path.display()))?;
         written.push(path);
     }
     Ok(written)
+}
+
+/// Refuses an output path that exists and is not a regular file (a device, FIFO, socket or
+/// directory, followed through symbolic links): the rename would replace it with a regular
+/// file (as root, `--out /dev/null` turned the host's `/dev/null` into one).
+fn refuse_special(path: &Path) -> Result<()> {
+    let Ok(meta) = std::fs::metadata(path) else { return Ok(()) };
+    if meta.is_file() {
+        return Ok(());
+    }
+    anyhow::bail!(
+        "the output {} is {}, not a regular file; smithwalk writes only regular files: choose another path",
+        path.display(),
+        kind_of(&meta.file_type())
+    )
+}
+
+/// The kind of a file that is not a regular file, in words.
+#[cfg(unix)]
+fn kind_of(t: &std::fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    if t.is_dir() {
+        "a directory"
+    } else if t.is_fifo() {
+        "a FIFO"
+    } else if t.is_socket() {
+        "a socket"
+    } else if t.is_block_device() || t.is_char_device() {
+        "a device"
+    } else {
+        "a special file"
+    }
+}
+
+#[cfg(not(unix))]
+fn kind_of(t: &std::fs::FileType) -> &'static str {
+    if t.is_dir() { "a directory" } else { "a special file" }
 }
 
 fn temp_file(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
@@ -136,5 +180,34 @@ mod tests {
         let e = format!("{:#}", super::prepare_dir(&file).unwrap_err());
         assert!(e.starts_with(&format!("cannot create the output directory {}: ", file.display())), "{e}");
         assert!(!e.contains("--out"), "{e}");
+    }
+
+    /// Issue 36 item 1: an output path that is a FIFO or a directory is refused with one line
+    /// naming it, and left as it was (the rename used to replace it by a regular file).
+    #[cfg(unix)]
+    #[test]
+    fn an_output_that_is_not_a_regular_file_is_refused() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("pipe");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+        assert!(made.success());
+        let e = format!("{:#}", super::write_file_atomically(&fifo, b"x".to_vec()).unwrap_err());
+        assert!(e.contains("is a FIFO, not a regular file"), "{e}");
+        assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+
+        let sub = dir.path().join("sub");
+        std::fs::create_dir(&sub).unwrap();
+        let e = format!("{:#}", super::write_atomically(dir.path(), &[("sub", b"x".to_vec())]).unwrap_err());
+        assert!(e.contains("is a directory, not a regular file"), "{e}");
+        assert!(sub.is_dir());
+        // Nothing was staged: no temporary file is left behind.
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names.len(), 2, "{names:?}");
+
+        // A device is refused before anything is written, even into /dev.
+        let e = format!("{:#}", super::write_file_atomically(std::path::Path::new("/dev/null"), vec![]).unwrap_err());
+        assert!(e.contains("/dev/null is a device, not a regular file"), "{e}");
+        assert!(std::fs::metadata("/dev/null").unwrap().file_type().is_char_device());
     }
 }
