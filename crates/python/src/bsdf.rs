@@ -108,16 +108,26 @@ fn dir(a: &ArrayView2<'_, f64>, lane: usize) -> DVec3 {
     DVec3::new(a[[lane, 0]], a[[lane, 1]], a[[lane, 2]])
 }
 
-/// Runs `f` on `threads` threads (rayon's global pool when `None`).
-fn in_pool<T: Send>(threads: Option<usize>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+/// `f` of every lane `0..n`, in parallel on `threads` threads (rayon's global pool when
+/// `None`), the GIL released. The lanes are independent, so the result does not depend on the
+/// thread count.
+fn per_lane<T: Send>(
+    py: Python<'_>,
+    threads: Option<usize>,
+    n: usize,
+    f: impl Fn(usize) -> T + Sync,
+) -> PyResult<Vec<T>> {
+    let run = || (0..n).into_par_iter().map(&f).collect::<Vec<_>>();
     match threads {
-        None => Ok(f()),
+        None => Ok(py.detach(run)),
         Some(0) => Err(PyValueError::new_err("`threads` = 0 is not allowed: at least 1 thread")),
-        Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .map(|pool| pool.install(f))
-            .map_err(|e| PyValueError::new_err(format!("`threads` = {t}: {e}"))),
+        Some(t) => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .map_err(|e| PyValueError::new_err(format!("`threads` = {t}: {e}")))?;
+            Ok(py.detach(|| pool.install(run)))
+        }
     }
 }
 
@@ -172,16 +182,9 @@ fn bsdf_sample<'py>(
     let lanes = params.lanes();
     let bsdfs = lanes.all()?;
     let (wi, u) = (wi.as_array(), u.as_array());
-    let samples = py.detach(|| {
-        in_pool(threads, || {
-            (0..bsdfs.len())
-                .into_par_iter()
-                .map(|i| {
-                    let numbers: Vec<f64> = u.index_axis(Axis(0), i).to_vec();
-                    bsdfs[i].sample(dir(&wi, i), mode, &mut stream(seed, &numbers))
-                })
-                .collect::<Vec<_>>()
-        })
+    let samples = per_lane(py, threads, bsdfs.len(), |i| {
+        let numbers: Vec<f64> = u.index_axis(Axis(0), i).to_vec();
+        bsdfs[i].sample(dir(&wi, i), mode, &mut stream(seed, &numbers))
     })?;
     let n = samples.len();
     let wo = Array2::from_shape_fn((n, 3), |(i, c)| samples[i].wo[c]);
@@ -207,16 +210,9 @@ fn bsdf_eval<'py>(
     let lanes = params.lanes();
     let bsdfs = lanes.all()?;
     let (wi, wo) = (wi.as_array(), wo.as_array());
-    let values = py.detach(|| {
-        in_pool(threads, || {
-            (0..bsdfs.len())
-                .into_par_iter()
-                .map(|i| {
-                    let (a, b) = (dir(&wi, i), dir(&wo, i));
-                    bsdfs[i].eval(a, b, mode, &mut stream(seed, &[a.x, a.y, a.z, b.x, b.y, b.z]))
-                })
-                .collect::<Vec<_>>()
-        })
+    let values = per_lane(py, threads, bsdfs.len(), |i| {
+        let (a, b) = (dir(&wi, i), dir(&wo, i));
+        bsdfs[i].eval(a, b, mode, &mut stream(seed, &[a.x, a.y, a.z, b.x, b.y, b.z]))
     })?;
     Ok(Array2::from_shape_fn((values.len(), 3), |(i, c)| values[i][c]).into_pyarray(py))
 }
@@ -234,11 +230,7 @@ fn bsdf_pdf<'py>(
     let lanes = params.lanes();
     let bsdfs = lanes.all()?;
     let (wi, wo) = (wi.as_array(), wo.as_array());
-    let values = py.detach(|| {
-        in_pool(threads, || {
-            (0..bsdfs.len()).into_par_iter().map(|i| bsdfs[i].pdf(dir(&wi, i), dir(&wo, i))).collect::<Vec<_>>()
-        })
-    })?;
+    let values = per_lane(py, threads, bsdfs.len(), |i| bsdfs[i].pdf(dir(&wi, i), dir(&wo, i)))?;
     Ok(Array1::from_vec(values).into_pyarray(py))
 }
 
