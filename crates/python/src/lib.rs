@@ -4,6 +4,8 @@
 //! and readers, and runs the crate's `compare`. The Python half (`python/smithwalk/`) builds the
 //! user-facing objects on top of these functions.
 
+mod bsdf;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -525,5 +527,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(model_names, m)?)?;
     m.add_function(wrap_pyfunction!(columns, m)?)?;
     m.add_function(wrap_pyfunction!(files, m)?)?;
+    bsdf::register(m)?;
     Ok(())
 }

@@ -457,3 +457,4 @@ def _model_names(models_csv: bytes):
     column ``<name>_stderr``."""
     header = next(csv.reader([models_csv.split(b"\n", 1)[0].decode()]))
     return [name for name in header if f"{name}{_STDERR}" in header]
+from . import bsdf  # noqa: E402  (smithwalk.bsdf: the BSDF for renderers)
