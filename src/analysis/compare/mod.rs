@@ -16,8 +16,8 @@
 //! `single`, order 1 alone, is never tested against a "1+" slot. With `max_order = 1` the "1+"
 //! slot is the all-orders lobe, which is tested once, as order 0.
 //!
-//! This module drives; its children each do one job: [`predict`] (models to per-bin values),
-//! [`verdict`] (the statistics), [`report`] (console and CSV text) and [`lobe`] (a lobe's key,
+//! This module drives; its children each do one job: `predict` (models to per-bin values),
+//! `verdict` (the statistics), `report` (console and CSV text) and `lobe` (a lobe's key,
 //! folding and which lobes are tested).
 
 mod lobe;
