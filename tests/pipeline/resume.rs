@@ -40,23 +40,34 @@ fn killed_and_resumed_runs_equal_an_uninterrupted_run() {
     let out = root.path().join("interrupted");
     let out_arg = out.to_str().unwrap();
     let args = ["run", config, "--out", out_arg, "--resume", "--checkpoint-seconds", "0.05"];
-    // Kill times from a fixed linear congruential sequence (reproducible "random moments").
+    // Each run is killed at a moment after it has written a new checkpoint, plus a delay
+    // from a fixed linear congruential sequence (reproducible "random moments"). Waiting for
+    // the checkpoint rather than for a fixed time keeps the test meaningful on a loaded
+    // machine, where a process may need seconds before its first checkpoint.
+    let checkpoint = out.join("checkpoint.bin");
+    let written = || std::fs::metadata(&checkpoint).and_then(|m| m.modified()).ok();
     let mut state: u64 = 12345;
     let mut resumed_from_checkpoint = 0;
     for _ in 0..5 {
         state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        let delay = 400 + (state >> 33) % 800;
-        if out.join("checkpoint.bin").exists() {
+        let delay = (state >> 33) % 300;
+        let before = written();
+        if before.is_some() {
             resumed_from_checkpoint += 1;
         }
         let mut child = smithwalk_quiet(&args).spawn().unwrap();
+        let start = std::time::Instant::now();
+        while written() == before && child.try_wait().unwrap().is_none() {
+            assert!(start.elapsed() < Duration::from_secs(120), "no checkpoint written in 120 s");
+            std::thread::sleep(Duration::from_millis(5));
+        }
         std::thread::sleep(Duration::from_millis(delay));
         if child.try_wait().unwrap().is_none() {
             child.kill().unwrap(); // SIGKILL
         }
         child.wait().unwrap();
     }
-    assert!(resumed_from_checkpoint > 0, "no kill left a checkpoint to resume from");
+    assert!(resumed_from_checkpoint >= 4, "only {resumed_from_checkpoint} runs resumed from a checkpoint");
     assert!(smithwalk_quiet(&args).status().unwrap().success());
     assert!(tables(&reference) == tables(&out), "resumed run differs from the uninterrupted run");
     assert!(!out.join("checkpoint.bin").exists(), "checkpoint left behind after the run finished");
