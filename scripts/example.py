@@ -35,7 +35,7 @@ MODELS = ["wang-correlated", "wang-uncorrelated"]
 
 # The fixed style of these models in every smithwalk figure (src/exports/plot/style.rs,
 # scripts/plot_lobes.py): (colour, dash).
-MODEL_STYLE = {"wang-correlated": ("#e69f00", "-"), "wang-uncorrelated": ("#cc79a7", (0, (1, 1.5)))}
+MODEL_STYLE = {"wang-correlated": ("#cc79a7", "-"), "wang-uncorrelated": ("#332288", (0, (1, 1.5)))}
 
 
 def plane_of_incidence(energy, cos_edges, phi_edges_deg):
@@ -52,6 +52,14 @@ def signed_angles(cos_edges):
     """Outgoing polar angle of each cos bin's centre, in degrees: the light's side negative."""
     theta = np.degrees(np.arccos(0.5 * (cos_edges[:-1] + cos_edges[1:])))
     return -theta, theta
+
+
+def across_the_plane(sides, x_sides):
+    """Both sides of the plane of incidence as one curve from the light's horizon to the
+    mirror side's, so that a line runs through theta_o = 0 instead of stopping short of it."""
+    x = np.concatenate(x_sides)
+    order = np.argsort(x)
+    return x[order], np.concatenate(sides)[order]
 
 
 def order_label(label):
@@ -94,21 +102,22 @@ def main():
                 m: plane_of_incidence(comparison[m]["energy"][j, k, 0], result.cos_edges, result.phi_edges_deg)
                 for m in MODELS
             }
-            for side, x in enumerate((back_x, mirror_x)):
-                label = side == 1  # one legend entry per curve
-                ax.errorbar(x, walk[side], yerr=err[side], fmt=".", color="black", ms=3,
-                            label="random walk (±1 SE)" if label else None)
-                for m in MODELS:
-                    colour, dash = MODEL_STYLE[m]
-                    ax.plot(x, models[m][side], color=colour, ls=dash, lw=1, label=m if label else None)
+            x, y = across_the_plane(walk, (back_x, mirror_x))
+            _, yerr = across_the_plane(err, (back_x, mirror_x))
+            ax.errorbar(x, y, yerr=yerr, fmt=".", color="black", ms=3, label="random walk (±1 SE)")
+            for m in MODELS:
+                colour, dash = MODEL_STYLE[m]
+                ax.plot(*across_the_plane(models[m], (back_x, mirror_x)), color=colour, ls=dash, lw=1, label=m)
             if i == 0:
                 ax.set_title(f"alpha {case['alpha_x']}, theta_i {case['theta_i_deg']:g} deg", fontsize=9)
             if j == 0:
                 ax.set_ylabel(f"{order_label(result.orders[k])}\nf·|cos θ_o| (1/sr)")
             if i == len(rows) - 1:
                 ax.set_xlabel("θ_o (deg), + mirror side, − light's side")
-    axes[0, 0].legend(fontsize=7)
-    fig.tight_layout()
+    # One legend above the panels, where it hides no data.
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
     args.out.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.out / "lobes.png", dpi=90)
     print(f"wrote {args.out / 'run'} and {args.out / 'lobes.png'}")

@@ -35,15 +35,15 @@ BIN_EDGES = ["cos_lo", "cos_hi", "phi_lo_deg", "phi_hi_deg"]
 SURFACE = ["ndf", "alpha_x", "alpha_y", "height", "smith", "normals", "material", "phi_i_deg", "side"]
 # The fixed style of every model, as in src/exports/plot/style.rs: (colour, dash).
 MODEL_STYLE = {
-    "single": ("#009e73", "-"),
+    "single": ("#117733", "-"),
     "hammon-fit": ("#882255", "-"),
     "heitz-nee": ("#0072b2", (0, (3.5, 2))),
     "exact-position-free": ("#d55e00", (0, (7, 2))),
-    "wang-correlated": ("#e69f00", "-"),
-    "wang-uncorrelated": ("#cc79a7", (0, (1, 1.5))),
-    "kulla-conty": ("#56b4e9", "-"),
-    "turquin": ("#b08c00", (0, (3.5, 2))),
-    "fdez-aguera": ("#336666", (0, (1, 1.5))),
+    "wang-correlated": ("#cc79a7", "-"),
+    "wang-uncorrelated": ("#332288", (0, (1, 1.5))),
+    "kulla-conty": ("#009e73", (0, (3.5, 2))),
+    "turquin": ("#999933", (0, (1, 1.5))),
+    "fdez-aguera": ("#ee6677", (0, (1, 1.5))),
     "external": ("#8c510a", (0, (7, 2))),
 }
 

@@ -185,10 +185,34 @@ fn both_sides_are_named_and_a_summed_row_is_told_from_a_folded_slot() {
     plot(dir.path(), &PlotOptions::default()).unwrap();
     let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
     for side in ["outside", "inside"] {
-        assert!(html.contains(&format!("<h2>GGX, α = 1, dielectric eta=1.5, light from {side}</h2>")), "{side}");
+        assert!(
+            html.contains(&format!("<h2>GGX, α = 1, dielectric eta=1.5, light from {side}, φ_i = 0.0°</h2>")),
+            "{side}"
+        );
     }
     assert!(!html.contains("side inside"), "the side reads the same for both groups");
     assert!(html.contains("made by the plot, of its orders 4 and higher, without error bars"), "summed row");
     assert!(!html.contains("folded slot"), "no folded slot in a run without max_order");
     assert!(html.contains("after 4 or more;") && html.contains("side the light comes from"), "albedo caption");
+}
+
+/// Issue 36 item 10 and 14: cases of a sweep over the incident azimuth are told apart wherever
+/// the polar angle is shown (report sections, heat-map captions, lobe panels); Beckmann is
+/// spelled as the literature spells it; a roughness sweep over two decades is drawn on a
+/// logarithmic axis.
+#[test]
+fn the_azimuth_and_the_ndf_are_named_and_decades_of_roughness_get_a_log_axis() {
+    let dir = tempfile::tempdir().unwrap();
+    let toml = "paths = 2000\nseed = 1\n[surface]\nndf = \"beckmann\"\nalpha = [0.01, 0.1, 1.0]\n[material]\nkind = \"conductor\"\nfresnel = \"none\"\n[incident]\ntheta_deg = [0, 60]\nphi_deg = [0, 45]\n[detector]\ncos_theta_bins = 8\nphi_bins = 16\nmax_order = 2\n";
+    run(toml, dir.path());
+    let out = dir.path().join("figures");
+    plot(dir.path(), &PlotOptions { format: Format::Svg, out: Some(out.clone()), ..PlotOptions::default() }).unwrap();
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    for phi in ["0.0", "45.0"] {
+        assert!(html.contains(&format!("Beckmann, α = 0.1, conductor F=1, φ_i = {phi}°</h2>")), "section of φ_i {phi}");
+        assert!(html.contains(&format!("θ_i = 60.0°, φ_i = {phi}°), reflection")), "heat-map caption of φ_i {phi}");
+    }
+    assert!(!html.contains("BECKMANN"));
+    let albedo = std::fs::read_to_string(out.join("albedo_vs_alpha.svg")).unwrap();
+    assert!(albedo.contains("(log scale)"), "roughness from 0.01 to 1 on a linear axis");
 }

@@ -193,7 +193,20 @@ impl<'a> AlbedoFigure<'a> {
         )
     }
 
+    /// Whether the x axis is logarithmic: a roughness sweep over a decade or more, where a
+    /// linear axis would crowd the smooth surfaces into its first tick.
+    fn log_x(&self) -> bool {
+        let xs = || self.panels.iter().flat_map(|(_, orders)| orders.values().flatten().map(|p| p.0));
+        let (lo, hi) = xs().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+        self.sweep == Sweep::Alpha && lo > 0.0 && hi >= 10.0 * lo
+    }
+
     fn panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, (caption, orders): &Panel) -> Result<()> {
+        // On a logarithmic axis the points are drawn at log10 x and the ticks name 10^v.
+        let log_x = self.log_x();
+        let at = |x: f64| if log_x { x.log10() } else { x };
+        let orders: BTreeMap<usize, Points> =
+            orders.iter().map(|(&i, points)| (i, points.iter().map(|&(x, y, e)| (at(x), y, e)).collect())).collect();
         let xs = orders.values().flatten().map(|p| p.0);
         let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
         let pad = 0.05 * (hi - lo).max(1e-9);
@@ -214,11 +227,13 @@ impl<'a> AlbedoFigure<'a> {
             .x_labels(6)
             .y_labels(5)
             .label_style((FONT, TICK))
-            .x_label_formatter(&|v| style::tick(*v, x_decimals))
+            .x_label_formatter(&|v| {
+                if log_x { style::significant(10f64.powf(*v)) } else { style::tick(*v, x_decimals) }
+            })
             .y_label_formatter(&|v| style::tick(*v, y_decimals))
             .draw()
             .map_err(draw_err)?;
-        for (i, points) in orders {
+        for (i, points) in &orders {
             let line = order_style(self.rows[*i]);
             let curve: Vec<(f64, f64)> = points.iter().map(|p| (p.0, p.1)).collect();
             style::draw_line(chart.plotting_area(), &curve, line)?;
@@ -249,7 +264,7 @@ impl AlbedoFigure<'_> {
             title: format!("Albedo {orders} against {x}{}", self.selection.suffix()),
             legend: self.legend(),
             y: "albedo".to_string(),
-            x: self.sweep.axis().to_string(),
+            x: if self.log_x() { format!("{} (log scale)", self.sweep.axis()) } else { self.sweep.axis().to_string() },
         }
     }
 }

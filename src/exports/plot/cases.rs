@@ -34,13 +34,39 @@ pub(super) fn varying(cases: &[Case]) -> Vec<usize> {
     (1..CASE_COLUMNS.len()).filter(|&c| fields.iter().any(|f| f[c] != fields[0][c])).collect()
 }
 
+/// An angle in degrees as captions name it (`θ_i = 30.0°`).
+fn angle(symbol: &str, degrees: f64) -> String {
+    format!("{symbol} = {degrees:.1}°")
+}
+
+/// The incident direction as titles name it, polar angle and azimuth (`θ_i = 30.0°, φ_i =
+/// 0.0°`): two cases of a sweep over `φ_i` must not look alike.
+pub(super) fn incidence(case: &Case) -> String {
+    format!("{}, {}", angle("θ_i", case.theta_i_deg), angle("φ_i", case.phi_i_deg))
+}
+
+/// The incident azimuth as titles name it (`φ_i = 45.0°`), for figures that sweep `θ_i`.
+pub(super) fn azimuth(case: &Case) -> String {
+    angle("φ_i", case.phi_i_deg)
+}
+
+/// An NDF's name as the literature spells it (`GGX`, `Beckmann`), from its config name.
+fn ndf_label(name: &str) -> String {
+    match name {
+        "ggx" => "GGX".to_string(),
+        "beckmann" => "Beckmann".to_string(),
+        other => other.to_string(),
+    }
+}
+
 /// How a case column reads in captions: a name and the value (`α_x = 0.5`, `θ_i = 30°`).
 fn pretty_field(column: usize, value: &str) -> String {
+    let degrees = || value.parse::<f64>().unwrap_or(f64::NAN);
     match CASE_COLUMNS[column].name {
         "alpha_x" => format!("α_x = {value}"),
         "alpha_y" => format!("α_y = {value}"),
-        "theta_i_deg" => format!("θ_i = {:.1}°", value.parse::<f64>().unwrap_or(f64::NAN)),
-        "phi_i_deg" => format!("φ_i = {value}°"),
+        "theta_i_deg" => angle("θ_i", degrees()),
+        "phi_i_deg" => angle("φ_i", degrees()),
         "material" => value.to_string(),
         "side" => format!("light from {value}"),
         name => format!("{name} {value}"),
@@ -74,7 +100,7 @@ pub(super) fn surface_label(run: &RunDir, case: &Case) -> String {
         format!("α = ({}, {})", case.roughness().x, case.roughness().y)
     };
     let fields = case_fields(case);
-    let mut label = format!("{}, {alpha}, {}", fields[1].to_uppercase(), fields[7]);
+    let mut label = format!("{}, {alpha}, {}", ndf_label(&fields[1]), fields[7]);
     for (column, default) in [(5, "exact"), (6, "vndf")] {
         if fields[column] != default {
             label.push_str(&format!(", {} {}", CASE_COLUMNS[column].name, fields[column]));
@@ -84,4 +110,10 @@ pub(super) fn surface_label(run: &RunDir, case: &Case) -> String {
         label.push_str(&format!(", {}", pretty_field(10, &fields[10])));
     }
     label
+}
+
+/// The name of a group of cases that differ only in `θ_i` (a lobe figure, a section of the
+/// report): the surface and the incident azimuth they share.
+pub(super) fn group_label(run: &RunDir, case: &Case) -> String {
+    format!("{}, {}", surface_label(run, case), azimuth(case))
 }

@@ -24,7 +24,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 
-use super::cases::surface_label;
+use super::cases::{incidence, surface_label};
 use super::rows::{Row, folded_note, highest_slot, row_bins, row_label};
 use super::selection::Selection;
 use super::style::{self, CAPTION, FONT, Figure, LABEL, TICK, TITLE, draw_err};
@@ -150,6 +150,9 @@ impl HeatFigure<'_> {
         let bins = &bins[..];
         let top = scale_top(bins, &self.stderrs(row, bins, highest));
         let scale = Scale::up_to(top, log);
+        // An order no light left through gets no colours and no colour bar: a bar from 0 to an
+        // arbitrary 1 would read as a measured scale.
+        let empty = top <= 0.0;
         let above = bins.iter().filter(|b| b.bsdf > top).count();
         let (caption, area) = area.split_vertically(CAPTION_HEIGHT);
         let (w, _) = caption.dim_in_pixel();
@@ -193,7 +196,7 @@ impl HeatFigure<'_> {
         let (pw, ph) = chart.plotting_area().dim_in_pixel();
         let (xr, yr) = (chart.x_range(), chart.y_range());
         let mut pixels = vec![255u8; (pw * ph * 3) as usize];
-        for py in 0..ph {
+        for py in (0..ph).filter(|_| !empty) {
             for px in 0..pw {
                 let x = xr.start + (px as f64 + 0.5) / pw as f64 * (xr.end - xr.start);
                 let y = yr.end - (py as f64 + 0.5) / ph as f64 * (yr.end - yr.start);
@@ -217,6 +220,12 @@ impl HeatFigure<'_> {
             chart.plotting_area().draw(&ring(WHITE, 4)).map_err(draw_err)?;
             chart.plotting_area().draw(&ring(BLACK, 2)).map_err(draw_err)?;
         }
+        if empty {
+            let (x, y) = chart.plotting_area().get_pixel_range();
+            let (ax, ay) = area.get_base_pixel();
+            let centre = ((x.start + x.end) / 2 - ax, (y.start + y.end) / 2 - ay);
+            return style::draw_centred(&area, "no light in this order", centre, CAPTION, false);
+        }
         // The colour bar, as tall as the map.
         let bar_top = MARGIN + (mh - 2 * MARGIN - X_AREA - ph) / 2;
         let bar = bar_area.margin(MARGIN + bar_top - MARGIN, MARGIN + X_AREA, 0, 0);
@@ -226,7 +235,7 @@ impl HeatFigure<'_> {
             .build_cartesian_2d(0.0..1.0, scale.range.0..scale.range.1)
             .map_err(draw_err)?;
         let decimals = style::tick_decimals(scale.range.0, scale.range.1, 5);
-        let label = |v: &f64| if log { significant(10f64.powf(*v)) } else { style::tick(*v, decimals) };
+        let label = |v: &f64| if log { style::significant(10f64.powf(*v)) } else { style::tick(*v, decimals) };
         bar_chart
             .configure_mesh()
             .disable_mesh()
@@ -255,18 +264,6 @@ impl HeatFigure<'_> {
     }
 }
 
-/// A positive number with two significant digits, in plain notation (0.0032, 0.1, 25) down to
-/// 10^-4 and in scientific notation below (3.2e-5, 1e-8).
-fn significant(x: f64) -> String {
-    if x < 1e-4 {
-        let text = format!("{x:.1e}");
-        return text.replacen(".0e", "e", 1);
-    }
-    let decimals = (1 - x.log10().floor() as i32).max(0) as usize;
-    let text = format!("{x:.decimals$}");
-    if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_string() } else { text }
-}
-
 impl Figure for HeatFigure<'_> {
     /// The panels' grid, widened where the title would not fit above it (a single panel); the
     /// panels keep their width, centred.
@@ -293,9 +290,9 @@ impl HeatFigure<'_> {
     fn title(&self) -> String {
         let hemisphere = if self.hemisphere == "T" { "transmission" } else { "reflection" };
         format!(
-            "{}, θ_i = {:.1}°: f over the {hemisphere} hemisphere (light from +x){}{}",
+            "{}, {}: f over the {hemisphere} hemisphere (light from +x){}{}",
             surface_label(self.run, self.case),
-            self.case.theta_i_deg,
+            incidence(self.case),
             if self.selection.log { ", log colour scale" } else { "" },
             self.selection.suffix()
         )
@@ -327,12 +324,12 @@ impl HeatFigure<'_> {
             ("reflection", "; a ring marks the mirror direction")
         };
         format!(
-            "Case {} ({}, θ_i = {:.1}°), {hemisphere}: the BSDF f (1/sr) per bounce order over the projected hemisphere, \
+            "Case {} ({}, {}), {hemisphere}: the BSDF f (1/sr) per bounce order over the projected hemisphere, \
              x = sin θ_o cos φ_o, y = sin θ_o sin φ_o with φ_o from the incident azimuth (the light comes from +x{mirror}). \
              Each pixel is interpolated between the centres of the detector bins around its direction (linearly in |cos θ_o| and φ_o; at the pole, the mean of the innermost ring), on {scale}. {top}{grazing}{}{}",
             self.case.index,
             surface_label(self.run, self.case),
-            self.case.theta_i_deg,
+            incidence(self.case),
             folded_note(self.run, self.rows, false),
             self.selection.note(),
         )
@@ -376,11 +373,11 @@ mod tests {
         assert_eq!(log.range.0, -3.0);
         assert!((log.level(0.02) - (0.02f64.log10() + 3.0) / (2f64.log10() + 3.0)).abs() < 1e-12);
         assert_eq!(log.level(0.0), 0.0);
-        assert_eq!(significant(0.001), "0.001");
-        assert_eq!(significant(0.000316), "0.00032");
-        assert_eq!(significant(25.0), "25");
-        assert_eq!(significant(1e-8), "1e-8");
-        assert_eq!(significant(3.16e-5), "3.2e-5");
+        assert_eq!(style::significant(0.001), "0.001");
+        assert_eq!(style::significant(0.000316), "0.00032");
+        assert_eq!(style::significant(25.0), "25");
+        assert_eq!(style::significant(1e-8), "1e-8");
+        assert_eq!(style::significant(3.16e-5), "3.2e-5");
     }
 
     /// A one-photon bin at the rim (relative standard error 1) does not set the scale; a

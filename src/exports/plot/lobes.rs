@@ -9,7 +9,7 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::cases::surface_label;
+use super::cases::{group_label, incidence};
 use super::points::{Points, bar_top};
 use super::rows::{Row, all_orders_only, folded_note, highest_slot, row_bins, row_label};
 use super::selection::Selection;
@@ -82,8 +82,9 @@ impl LobeFigure<'_> {
     }
 
     fn panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, case: &Case, row: Row) -> Result<()> {
-        let Some(bins) = self.bins(self.measured, case, row) else { return Ok(()) };
-        let points = plane_of_incidence(self.run, &bins);
+        // lobes.csv has no rows for an order no photon left in: its panel keeps its axes and
+        // says so, rather than leaving a hole in the grid.
+        let points = self.bins(self.measured, case, row).map(|b| plane_of_incidence(self.run, &b)).unwrap_or_default();
         // Per model drawn: its style, its curve and whether it is a Monte Carlo estimate.
         let lines: Vec<(style::LineStyle, Points, bool)> = self
             .models
@@ -101,7 +102,7 @@ impl LobeFigure<'_> {
             .fold(0.0_f64, f64::max);
         let top = if top > 0.0 && top.is_finite() { 1.08 * top } else { 1.0 };
         let decimals = style::tick_decimals(0.0, top, 5);
-        let caption = format!("{}, θ_i = {:.1}°", row_label(self.run, row), case.theta_i_deg);
+        let caption = format!("{}, {}", row_label(self.run, row), incidence(case));
         let mut chart = ChartBuilder::on(area)
             .caption(caption, (FONT, CAPTION))
             .margin(6)
@@ -144,6 +145,17 @@ impl LobeFigure<'_> {
         chart
             .draw_series(points.iter().map(|&(x, y, _)| Circle::new((x, y), 2, MEASURED.filled())))
             .map_err(draw_err)?;
+        if points.is_empty() && lines.is_empty() {
+            let (x, y) = chart.plotting_area().get_pixel_range();
+            let (ax, ay) = area.get_base_pixel();
+            let centre = ((x.start + x.end) / 2 - ax, (y.start + y.end) / 2 - ay);
+            let text = if row_label(self.run, row).starts_with("orders") {
+                "no light in these orders"
+            } else {
+                "no light in this order"
+            };
+            style::draw_centred(area, text, centre, CAPTION, false)?;
+        }
         Ok(())
     }
 
@@ -200,7 +212,7 @@ impl LobeFigure<'_> {
              measured from {} (positive on the {} side, φ_o = 180°; negative on the light's side, φ_o = 0°), {rows} \
              and one column per incident angle θ_i. Black points: the random walk, each the average over a detector \
              bin ({} bins in |cos θ_o|, {:.1}° of azimuth), with ±1 standard-error bars.{} {models}{}",
-            surface_label(self.run, self.cases[0]),
+            group_label(self.run, self.cases[0]),
             self.axis(),
             self.positive_side(),
             g.cos_bins,
@@ -225,7 +237,7 @@ impl LobeFigure<'_> {
     fn labels(&self) -> style::GridLabels {
         let hemisphere = if self.hemisphere == "T" { "transmission (T)" } else { "reflection (R)" };
         style::GridLabels {
-            title: format!("{}: {hemisphere}{}", surface_label(self.run, self.cases[0]), self.selection.suffix()),
+            title: format!("{}: {hemisphere}{}", group_label(self.run, self.cases[0]), self.selection.suffix()),
             legend: self.legend(),
             y: "f·|cos θ_o| (1/sr)".to_string(),
             x: format!("θ_o from {} (deg): + {} side, − light's side", self.axis(), self.positive_side()),

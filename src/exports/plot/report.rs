@@ -9,7 +9,7 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use super::cases::{describe, pretty_fields, surface_label, varying};
+use super::cases::{describe, group_label, pretty_fields, varying};
 use super::rows::slot_label;
 use super::selection::Selection;
 use crate::analysis::stats::sidak;
@@ -257,7 +257,7 @@ pub(super) fn page(
         }
     }
     for section in sections {
-        let _ = writeln!(html, "<h2>{}</h2>", escape(&surface_label(run, section.cases[0])));
+        let _ = writeln!(html, "<h2>{}</h2>", escape(&group_label(run, section.cases[0])));
         html.push_str("<table><tr><th>case</th>");
         for &c in &shown {
             let _ = write!(html, "<th>{}</th>", CASE_COLUMNS[c].name);

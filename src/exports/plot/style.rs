@@ -63,18 +63,21 @@ pub enum Marker {
     Cross,
 }
 
-/// Okabe and Ito's colour-blind-safe palette, plus a wine red.
+/// Okabe and Ito's colour-blind-safe palette and Tol's muted one, chosen so that every two
+/// models' colours stay apart in normal vision, protanopia and deuteranopia (test below) and
+/// each stands out on white.
 const BLUE: RGBColor = RGBColor(0x00, 0x72, 0xb2);
 const ORANGE: RGBColor = RGBColor(0xe6, 0x9f, 0x00);
 const GREEN: RGBColor = RGBColor(0x00, 0x9e, 0x73);
 const VERMILLION: RGBColor = RGBColor(0xd5, 0x5e, 0x00);
 const PURPLE: RGBColor = RGBColor(0xcc, 0x79, 0xa7);
 const WINE: RGBColor = RGBColor(0x88, 0x22, 0x55);
-const GREY: RGBColor = RGBColor(0x77, 0x77, 0x77);
-const SKY: RGBColor = RGBColor(0x56, 0xb4, 0xe9);
-const OCHRE: RGBColor = RGBColor(0xb0, 0x8c, 0x00);
-const TEAL: RGBColor = RGBColor(0x33, 0x66, 0x66);
+const INDIGO: RGBColor = RGBColor(0x33, 0x22, 0x88);
+const FOREST: RGBColor = RGBColor(0x11, 0x77, 0x33);
+const OLIVE: RGBColor = RGBColor(0x99, 0x99, 0x33);
+const ROSE: RGBColor = RGBColor(0xee, 0x66, 0x77);
 const BROWN: RGBColor = RGBColor(0x8c, 0x51, 0x0a);
+const GREY: RGBColor = RGBColor(0x77, 0x77, 0x77);
 
 const fn line(colour: RGBColor, dash: Dash) -> LineStyle {
     LineStyle { colour, dash, width: 2, marker: Marker::None }
@@ -83,15 +86,15 @@ const fn line(colour: RGBColor, dash: Dash) -> LineStyle {
 /// The style of a model's lines in every figure.
 pub fn model_style(model: Model) -> LineStyle {
     match model {
-        Model::Single => line(GREEN, Dash::Solid),
+        Model::Single => line(FOREST, Dash::Solid),
         Model::HammonFit => line(WINE, Dash::Solid),
         Model::HeitzNee => line(BLUE, Dash::Dashed),
         Model::ExactPositionFree => line(VERMILLION, Dash::LongDash),
-        Model::WangCorrelated => line(ORANGE, Dash::Solid),
-        Model::WangUncorrelated => line(PURPLE, Dash::Dotted),
-        Model::KullaConty => line(SKY, Dash::Solid),
-        Model::Turquin => line(OCHRE, Dash::Dashed),
-        Model::FdezAguera => line(TEAL, Dash::Dotted),
+        Model::WangCorrelated => line(PURPLE, Dash::Solid),
+        Model::WangUncorrelated => line(INDIGO, Dash::Dotted),
+        Model::KullaConty => line(GREEN, Dash::Dashed),
+        Model::Turquin => line(OLIVE, Dash::Dotted),
+        Model::FdezAguera => line(ROSE, Dash::Dotted),
         Model::External => line(BROWN, Dash::LongDash),
     }
 }
@@ -318,6 +321,18 @@ pub fn tick_decimals(lo: f64, hi: f64, n: usize) -> usize {
         .unwrap_or(0)
 }
 
+/// A positive number with two significant digits, in plain notation (0.0032, 0.1, 25) down to
+/// 10^-4 and in scientific notation below (3.2e-5, 1e-8).
+pub fn significant(x: f64) -> String {
+    if x < 1e-4 {
+        let text = format!("{x:.1e}");
+        return text.replacen(".0e", "e", 1);
+    }
+    let decimals = (1 - x.log10().floor() as i32).max(0) as usize;
+    let text = format!("{x:.decimals$}");
+    if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_string() } else { text }
+}
+
 /// A tick label: the value in plain decimal notation with `decimals` places (and `0` for zero).
 pub fn tick(v: f64, decimals: usize) -> String {
     if v.abs() < 1e-12 { "0".into() } else { format!("{v:.decimals$}") }
@@ -381,6 +396,52 @@ pub fn render(figure: &impl Figure, format: Format) -> Result<Vec<u8>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// CIE L*a*b* (D65) of an sRGB colour whose linear components `rgb` are first mixed by
+    /// `vision` (Machado, Oliveira and Fernandes 2009's matrices for full protanopia and
+    /// deuteranopia, in linear RGB; the identity for normal vision).
+    fn lab(colour: RGBColor, vision: &[[f64; 3]; 3]) -> [f64; 3] {
+        let linear = |c: u8| {
+            let c = c as f64 / 255.0;
+            if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+        };
+        let l = [linear(colour.0), linear(colour.1), linear(colour.2)];
+        let [r, g, b] = vision.map(|row| (row[0] * l[0] + row[1] * l[1] + row[2] * l[2]).clamp(0.0, 1.0));
+        let xyz = [
+            (0.4124 * r + 0.3576 * g + 0.1805 * b) / 0.95047,
+            0.2126 * r + 0.7152 * g + 0.0722 * b,
+            (0.0193 * r + 0.1192 * g + 0.9505 * b) / 1.08883,
+        ];
+        let f = |t: f64| {
+            if t > (6.0f64 / 29.0).powi(3) { t.cbrt() } else { t / (3.0 * (6.0f64 / 29.0).powi(2)) + 4.0 / 29.0 }
+        };
+        let [fx, fy, fz] = xyz.map(f);
+        [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)]
+    }
+
+    /// Every two models' colours differ by a CIE76 colour difference of at least 11 in normal
+    /// vision, protanopia and deuteranopia (the palette before, with orange beside vermillion
+    /// and ochre, came to 3.3), and every colour is dark enough to read on white (L* below 70).
+    #[test]
+    fn model_colours_stay_apart_for_colour_blind_readers() {
+        let normal = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let protanopia =
+            [[0.152286, 1.052583, -0.204868], [0.114503, 0.786281, 0.099216], [-0.003882, -0.048116, 1.051998]];
+        let deuteranopia =
+            [[0.367322, 0.860646, -0.227968], [0.280085, 0.672501, 0.047413], [-0.011820, 0.042940, 0.968881]];
+        let models: Vec<Model> = Model::ALL.into_iter().chain([Model::External]).collect();
+        for (i, &a) in models.iter().enumerate() {
+            let luminance = lab(model_style(a).colour, &normal)[0];
+            assert!(luminance < 70.0, "{} is too light on white (L* {luminance:.0})", a.name());
+            for &b in &models[i + 1..] {
+                for vision in [&normal, &protanopia, &deuteranopia] {
+                    let (la, lb) = (lab(model_style(a).colour, vision), lab(model_style(b).colour, vision));
+                    let difference = la.iter().zip(lb).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt();
+                    assert!(difference >= 11.0, "{} and {}: colour difference {difference:.1}", a.name(), b.name());
+                }
+            }
+        }
+    }
 
     #[test]
     fn every_model_and_order_has_its_own_style() {
