@@ -21,10 +21,14 @@
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 
-use crate::facet::{Facet, ParameterError, Side, mirror_density, refraction_density};
+use crate::facet::{
+    Conductor, ConductorFresnel, Dielectric, Facet, Hammon, Lambertian, ParameterError, Side, mirror_density,
+    refraction_density,
+};
 use crate::fresnel;
 use crate::height::other_side_depth;
-use crate::ndf::Ndf;
+use crate::material::Material;
+use crate::ndf::{AnyNdf, Beckmann, Ggx, Ndf, Roughness};
 use crate::nee::contribution;
 use crate::normals::Normals;
 use crate::random::{exp1, open01};
@@ -103,6 +107,16 @@ pub enum BsdfError {
         /// What the BSDF needs there.
         allowed: &'static str,
     },
+    /// A name or a choice that is not one of the allowed ones (a [`Description`]'s `ndf`,
+    /// `material`, `fresnel`, or an empty set of orders).
+    Choice {
+        /// The field, as renderers spell it.
+        field: &'static str,
+        /// The value given, as text.
+        value: String,
+        /// What is allowed, in words.
+        allowed: &'static str,
+    },
 }
 
 impl std::fmt::Display for BsdfError {
@@ -110,6 +124,9 @@ impl std::fmt::Display for BsdfError {
         match self {
             BsdfError::Parameter(e) => e.fmt(f),
             BsdfError::Model { field, allowed } => write!(f, "{field}: the BSDF needs {allowed}"),
+            BsdfError::Choice { field, value, allowed } => {
+                write!(f, "{field} = {value} is not allowed: allowed is {allowed}")
+            }
         }
     }
 }
@@ -134,6 +151,80 @@ pub struct Sample<const C: usize> {
     pub weight: [f64; C],
     /// The photon's scattering order (0 if it never escaped).
     pub order: u32,
+}
+
+/// A reference BSDF as a renderer names it: the NDF and the facet material by name, every
+/// parameter any material takes in RGB (those its material does not use are ignored), and the
+/// orders. The bindings for other languages (Python, C) build their BSDFs here, so that they
+/// accept the same names and ranges and report the same errors.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Description<'a> {
+    /// The NDF: `"ggx"` or `"beckmann"`.
+    pub ndf: &'a str,
+    /// The roughness along the tangent `x` (`alpha_u`) and `y` (`alpha_v`) axes; both finite
+    /// and > 0.
+    pub alpha: Roughness,
+    /// The facets (§4.2-4.5): `"conductor"`, `"dielectric"`, `"lambertian"` or `"hammon"`.
+    pub material: &'a str,
+    /// A conductor's Fresnel reflectance: `"none"` (F = 1, a lossless mirror), `"schlick"`
+    /// (from `f0`) or `"exact"` (from `eta` and `k`); ignored by the other materials.
+    pub fresnel: &'a str,
+    /// A conductor's real index per channel (`fresnel = "exact"`); a dielectric's relative
+    /// index `n_inside / n_outside` in the first channel.
+    pub eta: [f64; 3],
+    /// A conductor's extinction coefficient per channel (`fresnel = "exact"`).
+    pub k: [f64; 3],
+    /// The reflectance at normal incidence: a Schlick conductor's, or Hammon's coat.
+    pub f0: [f64; 3],
+    /// The diffuse albedo of Lambertian facets or of Hammon's base.
+    pub albedo: [f64; 3],
+    /// The orders kept; not empty.
+    pub orders: Orders,
+}
+
+impl Description<'_> {
+    /// The BSDF described, on the true Smith microsurface with visible normals (the surface
+    /// whose BSDF `eval` computes). Errors name the first field out of range or unknown.
+    pub fn bsdf(&self) -> Result<Bsdf<AnyNdf, Material<3>, 3>, BsdfError> {
+        let choice = |field, value: &str, allowed| BsdfError::Choice { field, value: format!("{value:?}"), allowed };
+        for (field, value) in [("alpha_u", self.alpha.x), ("alpha_v", self.alpha.y)] {
+            if !(value > 0.0 && value.is_finite()) {
+                return Err(ParameterError { field, value, allowed: "a finite number > 0" }.into());
+            }
+        }
+        let ndf = match self.ndf {
+            "ggx" => AnyNdf::Ggx(Ggx(self.alpha)),
+            "beckmann" => AnyNdf::Beckmann(Beckmann(self.alpha)),
+            other => return Err(choice("ndf", other, "\"ggx\" or \"beckmann\"")),
+        };
+        let material = match self.material {
+            "conductor" => Material::Conductor(Conductor {
+                fresnel: match self.fresnel {
+                    "none" => ConductorFresnel::None,
+                    "schlick" => ConductorFresnel::Schlick { f0: self.f0 },
+                    "exact" => ConductorFresnel::Exact { eta: self.eta, k: self.k },
+                    other => return Err(choice("fresnel", other, "\"none\", \"schlick\" or \"exact\"")),
+                },
+            }),
+            "dielectric" => Material::Dielectric(Dielectric { eta: self.eta[0] }),
+            "lambertian" => Material::Lambertian(Lambertian { albedo: self.albedo }),
+            "hammon" => Material::Hammon(Hammon { f0: self.f0, albedo: self.albedo }),
+            other => {
+                return Err(choice("material", other, "\"conductor\", \"dielectric\", \"lambertian\" or \"hammon\""));
+            }
+        };
+        let Orders { mask, from } = self.orders;
+        if from == 0 || (mask == 0 && from == u32::MAX) {
+            return Err(BsdfError::Choice {
+                field: "orders",
+                value: format!("(mask {mask:#x}, from {from})"),
+                allowed: "a set of at least one order: bit k - 1 of the mask for order k, \
+                          from >= 1 for every order from there on (4294967295: none)",
+            });
+        }
+        let surface = Microsurface { ndf, smith: Smith::Exact, normals: Normals::Visible };
+        Ok(Bsdf::new(surface, material)?.with_orders(self.orders))
+    }
 }
 
 /// The random stream of one BSDF call: PCG 64 (multiplicative congruential, 128-bit state).

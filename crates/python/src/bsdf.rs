@@ -2,7 +2,8 @@
 //! numpy batches, one lane per row, for renderers (docs/rendering.md, "Python").
 //!
 //! The Python wrapper (`python/smithwalk/bsdf.py`) broadcasts every parameter to one value per
-//! lane; here each lane's parameters are checked and built into a [`Bsdf`] before any walk, and
+//! lane; here each lane's parameters are checked and built into a [`Bsdf`] ([`Description`], shared
+//! with the C ABI) before any walk, and
 //! the lanes then run in parallel on rayon with the GIL released. Each lane draws from its own
 //! stream ([`stream`]) keyed by the caller's seed and the lane's numbers, so the results do not
 //! depend on the thread count.
@@ -13,13 +14,9 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use smithwalk::microsurface::DVec3;
-use smithwalk::microsurface::bsdf::{Bsdf, Orders, Transport, stream};
-use smithwalk::microsurface::facet::{Conductor, ConductorFresnel, Dielectric, Hammon, Lambertian};
+use smithwalk::microsurface::bsdf::{Bsdf, Description, Orders, Transport, stream};
 use smithwalk::microsurface::material::Material;
-use smithwalk::microsurface::ndf::{AnyNdf, Beckmann, Ggx, Roughness};
-use smithwalk::microsurface::normals::Normals;
-use smithwalk::microsurface::smith::Smith;
-use smithwalk::microsurface::walk::Microsurface;
+use smithwalk::microsurface::ndf::{AnyNdf, Roughness};
 
 /// The BSDF of one lane: RGB, any NDF, any facet material.
 type LaneBsdf = Bsdf<AnyNdf, Material<3>, 3>;
@@ -42,50 +39,21 @@ fn rgb(a: &ArrayView2<'_, f64>, lane: usize) -> [f64; 3] {
     [a[[lane, 0]], a[[lane, 1]], a[[lane, 2]]]
 }
 
-fn bad(field: &str, lane: usize, value: impl std::fmt::Display, allowed: &str) -> PyErr {
-    PyValueError::new_err(format!("`{field}` = {value} (lane {lane}) is not allowed: {allowed}"))
-}
-
 impl Lanes<'_> {
-    /// The lane's facet material (§4.2-4.5).
-    fn material(&self, lane: usize) -> PyResult<Material<3>> {
-        Ok(match (self.material, self.fresnel) {
-            ("conductor", "none") => Material::Conductor(Conductor { fresnel: ConductorFresnel::None }),
-            ("conductor", "schlick") => {
-                Material::Conductor(Conductor { fresnel: ConductorFresnel::Schlick { f0: rgb(&self.f0, lane) } })
-            }
-            ("conductor", "exact") => Material::Conductor(Conductor {
-                fresnel: ConductorFresnel::Exact { eta: rgb(&self.eta, lane), k: rgb(&self.k, lane) },
-            }),
-            ("conductor", other) => {
-                return Err(bad("fresnel", lane, format!("{other:?}"), "\"none\", \"schlick\" or \"exact\""));
-            }
-            ("dielectric", _) => Material::Dielectric(Dielectric { eta: self.eta[[lane, 0]] }),
-            ("lambertian", _) => Material::Lambertian(Lambertian { albedo: rgb(&self.albedo, lane) }),
-            ("hammon", _) => Material::Hammon(Hammon { f0: rgb(&self.f0, lane), albedo: rgb(&self.albedo, lane) }),
-            (other, _) => {
-                return Err(bad(
-                    "material",
-                    lane,
-                    format!("{other:?}"),
-                    "\"conductor\", \"dielectric\", \"lambertian\" or \"hammon\"",
-                ));
-            }
-        })
-    }
-
-    /// The lane's BSDF, its parameters checked by [`Bsdf::new`].
+    /// The lane's BSDF, its parameters checked by [`Description::bsdf`].
     fn bsdf(&self, lane: usize) -> PyResult<LaneBsdf> {
-        let roughness = Roughness { x: self.alpha_u[lane], y: self.alpha_v[lane] };
-        let ndf = match self.ndf {
-            "ggx" => AnyNdf::Ggx(Ggx(roughness)),
-            "beckmann" => AnyNdf::Beckmann(Beckmann(roughness)),
-            other => return Err(bad("ndf", lane, format!("{other:?}"), "\"ggx\" or \"beckmann\"")),
+        let description = Description {
+            ndf: self.ndf,
+            alpha: Roughness { x: self.alpha_u[lane], y: self.alpha_v[lane] },
+            material: self.material,
+            fresnel: self.fresnel,
+            eta: rgb(&self.eta, lane),
+            k: rgb(&self.k, lane),
+            f0: rgb(&self.f0, lane),
+            albedo: rgb(&self.albedo, lane),
+            orders: self.orders,
         };
-        let surface = Microsurface { ndf, smith: Smith::Exact, normals: Normals::Visible };
-        let bsdf =
-            Bsdf::new(surface, self.material(lane)?).map_err(|e| PyValueError::new_err(format!("lane {lane}: {e}")))?;
-        Ok(bsdf.with_orders(self.orders))
+        description.bsdf().map_err(|e| PyValueError::new_err(format!("lane {lane}: {e}")))
     }
 
     /// Every lane's BSDF, or the first lane's error.
