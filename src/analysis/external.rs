@@ -20,6 +20,7 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 
 use crate::engine::detector::{Grid, Hemisphere};
+use crate::input;
 use crate::io::output::hemisphere_sign;
 use crate::io::rundir::RunDir;
 use crate::io::schema::{self, Column};
@@ -75,7 +76,8 @@ impl ExternalModel {
 pub fn read(path: &Path, run: &RunDir) -> Result<ExternalModel> {
     let (config, cases, grid) = (&run.config, &run.cases, run.grid);
     let file = path.display();
-    let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read external model {file}"))?;
+    let input = input::open(path, run.table_limit).with_context(|| format!("cannot read external model {file}"))?;
+    let mut reader = csv::Reader::from_reader(input);
     let headers = reader.headers().with_context(|| format!("{file}: cannot read the header line"))?.clone();
     let column = |c: Column| headers.iter().position(|h| h.trim() == c.name);
     let required = |c: Column| {
