@@ -69,6 +69,7 @@ pub mod atomic;
 pub mod commands;
 pub mod engine;
 pub mod exports;
+pub mod input;
 pub mod io;
 pub mod setup;
 

@@ -12,6 +12,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
+use crate::input;
+
 /// The quantity of `lut.csv` that the compensation models need: reflection, order 1 (single
 /// scattering) of the F = 1 conductor table.
 const QUANTITY: &str = "R_1";
@@ -47,7 +49,9 @@ pub fn linear(nodes: &[f64], values: &[f64], x: f64) -> f64 {
 /// row's line. Without a `quantity` column every row counts.
 fn rows(path: &Path, names: &[&str], allowed: &[(f64, f64, &str)]) -> Result<Vec<Vec<f64>>> {
     let file = path.display();
-    let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read albedo table {file}"))?;
+    let input =
+        input::open(path, input::MAX_TABLE_BYTES).with_context(|| format!("cannot read albedo table {file}"))?;
+    let mut reader = csv::Reader::from_reader(input);
     let headers = reader.headers().with_context(|| format!("{file}: cannot read the header line"))?.clone();
     let column = |name: &str| headers.iter().position(|h| h.trim() == name);
     let cols: Vec<usize> = names

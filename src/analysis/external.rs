@@ -11,8 +11,11 @@
 //! `∫_bin f(wi, wo) |cos theta_o| dwo`) and, optionally, `energy_stderr` (the model's own
 //! standard error if it is a Monte Carlo estimate; without it the model is exact). Every bin of
 //! a lobe (case, order, hemisphere, channel) must be given exactly once. The run's folded slot
-//! "K+" (`max_order = K`, every order from K on) is refused: a per-order model is never
-//! compared with it (give order 0, all orders, or orders below K).
+//! "K+" (`max_order = K`, every order from K on) is compared only with a model that folds at
+//! the same order: one whose optional `folded` column is `true` in that slot (as `models.csv`
+//! writes it), or the `lobes.csv` of another run directory (its `run.json` beside it, validated
+//! like the run's) with the same `detector.max_order`. A per-order model is never compared with
+//! a folded slot, nor a folded model's slot with a per-order one.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -20,6 +23,7 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 
 use crate::engine::detector::{Grid, Hemisphere};
+use crate::input;
 use crate::io::output::hemisphere_sign;
 use crate::io::rundir::RunDir;
 use crate::io::schema::{self, Column};
@@ -70,12 +74,30 @@ impl ExternalModel {
     }
 }
 
+/// The order from which the model at `path` folds every order into one slot, when `path` is the
+/// `lobes.csv` of another run directory (its `run.json` beside it, the directory validated as
+/// [`RunDir::open`] validates the run): that run's `detector.max_order`. `None` for any other
+/// file.
+fn other_run_folding(path: &Path) -> Result<Option<usize>> {
+    let Some(dir) = path.parent().filter(|_| path.file_name() == Some(schema::LOBES.file.as_ref())) else {
+        return Ok(None);
+    };
+    let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
+    if !dir.join(schema::RUN_JSON).exists() {
+        return Ok(None);
+    }
+    let other =
+        RunDir::open(dir).with_context(|| format!("the run directory of the external model {}", path.display()))?;
+    Ok(other.config.detector.max_order.map(|k| k as usize))
+}
+
 /// Reads and validates `path` against `run`; errors name the file, the line, the column, the
 /// value and what is allowed.
 pub fn read(path: &Path, run: &RunDir) -> Result<ExternalModel> {
     let (config, cases, grid) = (&run.config, &run.cases, run.grid);
     let file = path.display();
-    let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read external model {file}"))?;
+    let input = input::open(path, run.table_limit).with_context(|| format!("cannot read external model {file}"))?;
+    let mut reader = csv::Reader::from_reader(input);
     let headers = reader.headers().with_context(|| format!("{file}: cannot read the header line"))?.clone();
     let column = |c: Column| headers.iter().position(|h| h.trim() == c.name);
     let required = |c: Column| {
@@ -93,6 +115,8 @@ pub fn read(path: &Path, run: &RunDir) -> Result<ExternalModel> {
         required(schema::PHI_HI_DEG)?,
     ];
     let energy_col = required(schema::ENERGY)?;
+    let folded_col = column(schema::FOLDED);
+    let other_run_folds = other_run_folding(path)?;
     let stderr_col = column(schema::ENERGY_STDERR);
     let rgb = config.is_rgb();
     let channel_col = column(schema::CHANNEL);
@@ -128,13 +152,38 @@ pub fn read(path: &Path, run: &RunDir) -> Result<ExternalModel> {
                 field(order_col)
             )
         })?;
-        if let Some(max) = config.detector.max_order
-            && order >= max as usize
+        let run_folds = config.detector.max_order.map(|k| k as usize);
+        let model_folds_here = match folded_col {
+            Some(col) => match field(col) {
+                "true" => true,
+                "false" | "" => false,
+                other => {
+                    bail!("{}: {other:?} is not allowed: true (the slot K+ of a model folded at K) or false", at(col))
+                }
+            },
+            None => other_run_folds == Some(order),
+        };
+        if order > 0 && model_folds_here && run_folds != Some(order) {
+            let run_slot = match run_folds {
+                Some(k) if order > k => format!("the run has no slot {order} (it folds every order from {k} on)"),
+                _ => format!("the run's slot {order} is order {order} alone"),
+            };
+            bail!(
+                "{}: order {order} is not allowed: the model's slot {order} is \"{order}+\" (every order from {order} \
+                 on), and {run_slot}; compare runs whose detector.max_order is the same",
+                at(order_col)
+            );
+        }
+        if let Some(max) = run_folds
+            && order >= max
             && order > 0
+            && !model_folds_here
         {
             bail!(
                 "{}: order {order} is not allowed: the run's slot {max} is \"{max}+\" (every order from {max} on), \
-                 which a per-order model is never compared with; give order 0 (all orders) or an order below {max}",
+                 which a per-order model is never compared with; give order 0 (all orders) or an order below {max} \
+                 (a model folded at {max} too says so: a `folded` column, or another run's lobes.csv with its run.json \
+                 beside it)",
                 at(order_col)
             );
         }

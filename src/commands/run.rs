@@ -16,6 +16,10 @@ use crate::engine::shard::write_shard;
 use crate::engine::{RunOptions, Simulation};
 use crate::setup::config::{Config, Model};
 
+/// The longest `--checkpoint-seconds`: 10^6 s (11.6 days). A longer interval is no checkpoint at
+/// all for any run, and `Duration` cannot hold one above about 1.8e19 s.
+pub const MAX_CHECKPOINT_SECONDS: f64 = 1e6;
+
 /// The options of `smithwalk run`.
 #[derive(Clone)]
 pub struct RunArgs {
@@ -89,8 +93,12 @@ fn run_config(args: &RunArgs) -> Result<Config> {
     let allowed = limit.map_or(String::new(), |l| format!(" of {} allowed ({})", gigabytes(l.bytes), l.source));
     println!("memory: about {} at the peak{allowed}", gigabytes(estimate.bytes()));
     note_threads(args.threads);
-    if !(args.checkpoint_seconds.is_finite() && args.checkpoint_seconds > 0.0) {
-        bail!("`--checkpoint-seconds` = {} is not allowed: a positive number of seconds", args.checkpoint_seconds);
+    if !(args.checkpoint_seconds > 0.0 && args.checkpoint_seconds <= MAX_CHECKPOINT_SECONDS) {
+        bail!(
+            "`--checkpoint-seconds` = {} is not allowed: a positive number of seconds, at most {MAX_CHECKPOINT_SECONDS:e} \
+             (11.6 days)",
+            args.checkpoint_seconds
+        );
     }
     Ok(config)
 }

@@ -17,6 +17,7 @@ use serde::Deserialize;
 
 use crate::atomic::{DirLock, lock_dir};
 use crate::engine::detector::Grid;
+use crate::input;
 use crate::io::output::{TABLES, self_digest, sha256_hex};
 use crate::io::schema::{self, Column};
 use crate::setup::cases::Case;
@@ -30,10 +31,12 @@ pub(crate) struct Table {
 }
 
 impl Table {
-    pub fn read(path: &Path) -> Result<Self> {
-        let mut reader = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
-        let headers = reader.headers()?.clone();
-        let records = reader.records().collect::<Result<Vec<_>, _>>()?;
+    /// Reads the table at `path`, refusing a file of more than `limit` bytes.
+    pub fn read(path: &Path, limit: u64) -> Result<Self> {
+        let cannot_read = || format!("cannot read {}", path.display());
+        let mut reader = csv::Reader::from_reader(input::open(path, limit).with_context(cannot_read)?);
+        let headers = reader.headers().with_context(cannot_read)?.clone();
+        let records = reader.records().collect::<Result<Vec<_>, _>>().with_context(cannot_read)?;
         Ok(Self { path: path.to_path_buf(), headers, records })
     }
 
@@ -68,6 +71,9 @@ struct RunJson {
 
 #[derive(Deserialize)]
 struct FileRecord {
+    /// The table's size, which bounds what is read of it ([`input::bins_table_limit`]).
+    #[serde(default)]
+    bytes: u64,
     sha256: String,
 }
 
@@ -88,6 +94,8 @@ struct Shape<'a> {
     slots: Vec<usize>,
     channels: usize,
     grid: Grid,
+    /// The most bytes read of one of the run's tables.
+    table_limit: u64,
 }
 
 impl Shape<'_> {
@@ -122,7 +130,8 @@ impl Shape<'_> {
 /// `run.json` of `dir`, checked against the tables beside it.
 fn read_run_json(dir: &Path) -> Result<RunJson> {
     let path = dir.join(schema::RUN_JSON);
-    let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = input::read_to_string(&path, input::MAX_RUN_JSON_BYTES)
+        .with_context(|| format!("cannot read {}", path.display()))?;
     match self_digest(text.as_bytes()) {
         Some((range, digest)) if text.get(range.clone()) == Some(digest.as_str()) => {}
         Some(_) => bail!("{} is corrupt: its self_sha256 does not match its content; rerun the config", path.display()),
@@ -151,8 +160,9 @@ fn read_run_json(dir: &Path) -> Result<RunJson> {
     };
     for table in TABLES {
         let file = dir.join(table);
-        let bytes = std::fs::read(&file).with_context(|| format!("cannot read {}", file.display()))?;
         let recorded = files.get(table).with_context(|| format!("{}: no digest of {table}", path.display()))?;
+        let bytes = input::read(&file, input::bins_table_limit(recorded.bytes))
+            .with_context(|| format!("cannot read {}", file.display()))?;
         if sha256_hex(&bytes) != recorded.sha256 {
             bail!(
                 "{} is not the {table} that {} records (changed, damaged, or from an interrupted or other run); \
@@ -308,7 +318,7 @@ fn lobe_rows(shape: &Shape, hemispheres: usize, slots: usize) -> usize {
 /// hemisphere, channel and bin exactly once, with finite non-negative energies and BSDF
 /// values. Columns are found by name; others are allowed.
 fn read_lobes(path: &Path, shape: &Shape) -> Result<Lobes> {
-    let table = Table::read(path)?;
+    let table = Table::read(path, shape.table_limit)?;
     let keys = BinKeys::of(&table)?;
     let [energy, energy_stderr, bsdf, bsdf_stderr] =
         [schema::ENERGY, schema::ENERGY_STDERR, schema::BSDF, schema::BSDF_STDERR]
@@ -348,7 +358,7 @@ fn model_columns(headers: &csv::StringRecord) -> Vec<(String, usize, usize)> {
 /// such lobe) or both finite and non-negative. A model's BSDF is its energy over the bin's
 /// projected solid angle, as in `lobes.csv`.
 fn read_models(path: &Path, shape: &Shape) -> Result<HashMap<String, Lobes>> {
-    let table = Table::read(path)?;
+    let table = Table::read(path, shape.table_limit)?;
     let keys = BinKeys::of(&table)?;
     let models = model_columns(&table.headers);
     let (offsets, _) = shape.rows(&table, |hemispheres, slots| lobe_rows(shape, hemispheres, slots))?;
@@ -397,7 +407,7 @@ fn bin_of(grid: Grid, cos_lo: f64, cos_hi: f64, phi_lo_deg: f64) -> Option<(usiz
 /// (an unbiased estimate of 1 - the escaped energy, which may dip below 0 by noise), with
 /// finite non-negative standard errors and VOVs.
 fn check_summary(path: &Path, shape: &Shape) -> Result<()> {
-    let table = Table::read(path)?;
+    let table = Table::read(path, shape.table_limit)?;
     let col = |c| table.column(c);
     let (case_c, order_c, hemi_c, paths_c) =
         (col(schema::CASE)?, col(schema::ORDER)?, col(schema::SUMMARY_ROW)?, col(schema::PATHS)?);
@@ -486,6 +496,9 @@ pub struct RunDir {
     pub grid: Grid,
     /// Order slots of each case (the highest order with light, plus slot 0 for all orders).
     pub slots: Vec<usize>,
+    /// The most bytes read of one of its tables or of a table in its bins (`models.csv`,
+    /// `compare.csv`, `--external`): [`input::bins_table_limit`] of its `lobes.csv`.
+    pub table_limit: u64,
     /// A shared lock: no run writes into the directory while it is read.
     _lock: DirLock,
 }
@@ -520,7 +533,9 @@ impl RunDir {
                 crate::setup::config::DEFAULT_MAX_ORDER
             );
         }
-        let run = Self { path: path.to_path_buf(), config, cases, grid, slots, _lock: lock };
+        let lobes_bytes = run.files.as_ref().and_then(|f| f.get(TABLES[0])).map_or(0, |f| f.bytes);
+        let table_limit = input::bins_table_limit(lobes_bytes);
+        let run = Self { path: path.to_path_buf(), config, cases, grid, slots, table_limit, _lock: lock };
         let shape = run.shape();
         read_lobes(&path.join(TABLES[0]), &shape)?;
         check_summary(&path.join(TABLES[1]), &shape)?;
@@ -546,7 +561,13 @@ impl RunDir {
 
     fn shape(&self) -> Shape<'_> {
         let channels = if self.config.is_rgb() { 3 } else { 1 };
-        Shape { cases: &self.cases, slots: self.slots.clone(), channels, grid: self.grid }
+        Shape {
+            cases: &self.cases,
+            slots: self.slots.clone(),
+            channels,
+            grid: self.grid,
+            table_limit: self.table_limit,
+        }
     }
 
     /// For exports of reflection only: a one-line note of the transmission they drop (the
@@ -564,7 +585,8 @@ impl RunDir {
     /// The rows of `summary.csv`.
     pub fn summary(&self) -> Result<Vec<SummaryRow>> {
         let path = self.path.join(schema::SUMMARY.file);
-        let mut reader = csv::Reader::from_path(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        let file = input::open(&path, self.table_limit).with_context(|| format!("cannot read {}", path.display()))?;
+        let mut reader = csv::Reader::from_reader(file);
         reader.deserialize().map(|r| r.with_context(|| format!("{}: bad row", path.display()))).collect()
     }
 }

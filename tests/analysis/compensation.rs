@@ -434,3 +434,56 @@ fn external_models_are_read_into_the_runs_bins_and_bad_files_are_refused() {
     refused(&rows.lines().take(4).collect::<Vec<_>>().join("\n"), &["1 of its 4 bins are missing"]);
     refused(&rows.replace(",energy", ",power"), &["no column `energy`"]);
 }
+
+/// Issue 36 item 15: another smithwalk run as `--external` (its `lobes.csv`, `run.json` beside
+/// it). Two runs of the same config with different seeds fold at the same `max_order` (2), so
+/// their "2+" slots are compared too: the comparison runs (it refused "order 2 is not allowed"
+/// before) and, the two being the same physics, rejects no lobe at family level 0.01. A run that
+/// folds at 3 is refused in the slot where the two differ; a file that says it folds with a
+/// `folded` column is read like another run's.
+#[test]
+fn another_run_that_folds_at_the_same_order_is_compared_slot_for_slot() {
+    use smithwalk::analysis::external;
+    let dir = tempfile::tempdir().unwrap();
+    let (run, _) = common::run_config(dir.path(), "a", WALK);
+    let (other, _) = common::run_config(dir.path(), "b", &WALK.replace("seed = 18", "seed = 19"));
+    let options =
+        CompareOptions { external: Some(other.join("lobes.csv")), ..CompareOptions::new(vec![], None, Some(2)) };
+    let outcome = compare_with(&run, &options).unwrap();
+    let table = std::fs::read_to_string(run.join("compare.csv")).unwrap();
+    // Slots 0 (all orders), 1 and the folded 2 ("2+"), each tested once.
+    let mut reader = csv::Reader::from_reader(table.as_bytes());
+    let header = reader.headers().unwrap().clone();
+    let col = |n: &str| header.iter().position(|h| h == n).unwrap();
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    let tested: Vec<(&str, &str)> = rows.iter().map(|r| (&r[col("order")], &r[col("folded")])).collect();
+    assert_eq!(tested, [("0", "false"), ("1", "false"), ("2", "true")], "{table}");
+    // Two independent walks of one config: the p-values are uniform; at family level 0.01 over
+    // 3 lobes no rejection is expected (a false rejection has probability 0.01; seeds fixed).
+    assert_eq!(outcome.verdicts.iter().map(|v| v.rejected).sum::<usize>(), 0, "{}", outcome.report);
+    // A run folded at 3: its slot 2 is order 2 alone, the run's is "2+".
+    let (folds_at_3, _) = common::run_config(dir.path(), "c", &WALK.replace("max_order = 2", "max_order = 3"));
+    let opened = smithwalk::io::rundir::RunDir::open(&run).unwrap();
+    let e = format!("{:#}", external::read(&folds_at_3.join("lobes.csv"), &opened).unwrap_err());
+    assert!(e.contains("order 2 is not allowed: the run's slot 2 is \"2+\"") && e.contains("`order`"), "{e}");
+    // The other way round: a run folded at 2 against one folded at 3.
+    let opened_3 = smithwalk::io::rundir::RunDir::open(&folds_at_3).unwrap();
+    let e = format!("{:#}", external::read(&other.join("lobes.csv"), &opened_3).unwrap_err());
+    assert!(e.contains("the model's slot 2 is \"2+\"") && e.contains("the run's slot 2 is order 2 alone"), "{e}");
+    // The same rows copied elsewhere (no run.json beside them) are a per-order model: refused
+    // in slot 2; with a `folded` column saying so, accepted.
+    let text = std::fs::read_to_string(other.join("lobes.csv")).unwrap();
+    let copy = dir.path().join("copy.csv");
+    std::fs::write(&copy, &text).unwrap();
+    assert!(format!("{:#}", external::read(&copy, &opened).unwrap_err()).contains("never compared"));
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let order = header.split(',').position(|h| h == "order").unwrap();
+    let mut marked = format!("{header},folded\n");
+    for line in lines {
+        marked += &format!("{line},{}\n", line.split(',').nth(order) == Some("2"));
+    }
+    std::fs::write(&copy, marked).unwrap();
+    let model = external::read(&copy, &opened).unwrap();
+    assert!(model.lobes.iter().any(|l| l.order == 2));
+}

@@ -303,3 +303,92 @@ fn limits_are_checked_before_any_work() {
     assert!(e.contains("detector.cos_theta_bins") && e.contains("detector.max_order") && e.contains("GB"), "{e}");
     assert_eq!(e.lines().count(), 1, "{e}");
 }
+
+/// Issue 36 item 4: a 70 000-character material name panicked (a table column's width beyond
+/// what `format!` pads); `--checkpoint-seconds 1e20` panicked converting to a `Duration`.
+/// Both are refused with one line and nothing written.
+#[test]
+fn a_huge_name_and_a_huge_checkpoint_interval_are_refused_with_one_line() {
+    let long = BASE.replace("\"conductor\"", &format!("\"conductor\"\nname = \"{}\"", "x".repeat(70_000)));
+    let (code, e) = run(&long, &[]);
+    assert_eq!(code, Some(1), "{e}");
+    assert!(e.contains("`material.name` = a name of 70000 characters") && e.contains("at most 100"), "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+    // 100 characters, the most allowed, run.
+    let longest = BASE.replace("\"conductor\"", &format!("\"conductor\"\nname = \"{}\"", "é".repeat(100)));
+    Config::parse(&longest).unwrap();
+    for seconds in ["1e20", "inf", "0", "1000001"] {
+        let (code, e) = run(BASE, &["--checkpoint-seconds", seconds]);
+        assert_eq!(code, Some(1), "{seconds}: {e}");
+        assert!(e.contains("`--checkpoint-seconds` = ") && e.contains("at most 1e6"), "{seconds}: {e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+}
+
+/// Issue 36 item 4: a config read from an endless file (`/dev/zero`) grew memory until the
+/// process was killed. Every file read is bounded (`smithwalk::input`): a config one byte past
+/// 16 MiB (a sparse file) and `/dev/zero` are refused with one line, nothing written.
+#[test]
+fn files_beyond_their_size_limit_are_refused_with_one_line() {
+    use smithwalk::input::MAX_CONFIG_BYTES;
+    let dir = tempfile::tempdir().unwrap();
+    // A sparse file of 16 MiB + 1 byte.
+    let big = dir.path().join("big.toml");
+    let file = std::fs::File::create(&big).unwrap();
+    file.set_len(MAX_CONFIG_BYTES + 1).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_smithwalk"))
+        .args(["run", big.to_str().unwrap(), "--out", dir.path().join("out").to_str().unwrap()])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(e.contains("cannot read config") && e.contains("larger than 16 MiB, the most allowed"), "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(!dir.path().join("out").exists());
+    // /dev/zero itself, where there is one: endless, and refused at the same limit.
+    if std::path::Path::new("/dev/zero").exists() {
+        let e = Config::load(std::path::Path::new("/dev/zero")).unwrap_err().to_string();
+        assert!(e.contains("larger than 16 MiB"), "{e}");
+    }
+}
+
+/// As [`files_beyond_their_size_limit_are_refused_with_one_line`] for the tables `compare`
+/// reads, an external model and an albedo table one byte past 1 GiB: ignored in CI, where
+/// reading 1 GiB into the CSV reader's buffer costs seconds and gigabytes (run with `--ignored`).
+#[test]
+#[ignore]
+fn tables_beyond_their_size_limit_are_refused_with_one_line() {
+    use smithwalk::input::MAX_TABLE_BYTES;
+    let dir = tempfile::tempdir().unwrap();
+    let (run_dir, _) = crate::common::run_config(dir.path(), "small", BASE);
+    let table = dir.path().join("table.csv");
+    let file = std::fs::File::create(&table).unwrap();
+    file.set_len(MAX_TABLE_BYTES + 1).unwrap();
+    for option in ["--external", "--albedo-table"] {
+        let models = if option == "--external" { "single" } else { "kulla-conty" };
+        let out = Command::new(env!("CARGO_BIN_EXE_smithwalk"))
+            .args(["compare", run_dir.to_str().unwrap(), "--models", models, option, table.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{option}: {e}");
+        assert!(e.contains("larger than 1 GiB, the most allowed"), "{option}: {e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+        assert!(!run_dir.join("models.csv").exists());
+    }
+}
+
+/// Issue 36 item 4: `compare --paths` above 10^15 ran unbounded; it is refused like `run`'s.
+#[test]
+fn compare_paths_beyond_the_run_limit_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let (run_dir, _) = crate::common::run_config(dir.path(), "small", BASE);
+    let out = Command::new(env!("CARGO_BIN_EXE_smithwalk"))
+        .args(["compare", run_dir.to_str().unwrap(), "--models", "heitz-nee", "--paths", "1000000000000001"])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(e.contains("`--paths` = 1000000000000001 is not allowed") && e.contains("10^15"), "{e}");
+    assert!(!run_dir.join("models.csv").exists());
+}

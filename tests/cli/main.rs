@@ -6,5 +6,6 @@
 mod common;
 
 mod bad_input;
+mod documented_limits;
 mod memory;
 mod properties;

@@ -204,3 +204,16 @@ pub fn assert_lobes_agree(
         assert!(z.abs() < z_limit, "{label} order {k} {hemisphere:?}: {x:?} vs {y:?}, z = {z:.2}");
     }
 }
+
+/// Skips a test (or a part of it, `what`) that needs an optional tool, visibly: one line
+/// `skipped: WHAT: REASON` written straight to the process's stderr, which the test harness does
+/// not capture (it captures `eprintln!` and hides it for a passing test), so the line shows in
+/// plain `cargo test` output and `cargo test 2>&1 | grep -c '^skipped:'` counts the skips. Under
+/// CI (`CI` set and not empty, `false` or `0`; `.ci/run` sets it and installs every tool) a
+/// missing tool fails the test instead.
+pub fn skip(what: &str, reason: &str) {
+    use std::io::Write as _;
+    let in_ci = std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0");
+    assert!(!in_ci, "CI must run {what}, but {reason}");
+    let _ = writeln!(std::io::stderr(), "skipped: {what}: {reason}");
+}

@@ -11,3 +11,4 @@ mod plot;
 mod readme_snippet;
 mod report_browser;
 mod rgl;
+mod skips;

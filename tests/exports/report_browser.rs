@@ -3,8 +3,8 @@
 //! (`naturalWidth > 0`, read by a script in a test-only copy of the page and written into the
 //! DOM that `--dump-dom` prints), the page logged nothing to the console (the real page has no
 //! scripts, so any console line is an error, e.g. a blocked resource), and its screenshot is
-//! not blank. Without a browser the test is skipped with a message; under CI (`CI=true`) a
-//! missing browser is a failure.
+//! not blank. Without a browser the test is skipped with a visible `skipped:` line
+//! ([`common::skip`]); under CI (`CI` set) a missing browser is a failure.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -12,6 +12,11 @@ use std::time::{Duration, Instant};
 
 use smithwalk::exports::plot::{PlotOptions, plot};
 use smithwalk::setup::config::{Config, Model};
+
+use crate::common;
+
+/// Why the tests skip without a browser, and how to get one (`.ci/run` installs it under CI).
+const NO_BROWSER: &str = "no chromium on PATH (Debian: apt-get install chromium)";
 
 /// The first of Debian's and other distributions' Chromium commands on PATH.
 fn browser() -> Option<PathBuf> {
@@ -100,10 +105,7 @@ fn the_report_renders_in_chromium_with_every_image_and_no_error() {
     assert!(images >= 10, "{images} images");
 
     let Some(browser) = browser() else {
-        let ci = std::env::var("CI").is_ok_and(|v| v == "true");
-        assert!(!ci, "CI=true but no Chromium on PATH: .ci/run installs Debian's `chromium`");
-        eprintln!("SKIPPED report_browser: no chromium on PATH (Debian: apt-get install chromium)");
-        return;
+        return common::skip("tests/exports/report_browser.rs", NO_BROWSER);
     };
 
     // Every image decoded and no script or resource error, read from the DOM.
@@ -136,9 +138,7 @@ fn the_report_renders_in_chromium_with_every_image_and_no_error() {
 fn a_console_error_and_a_missing_image_are_caught() {
     // The checks themselves, on a page that has both faults.
     let Some(browser) = browser() else {
-        assert!(!std::env::var("CI").is_ok_and(|v| v == "true"), "CI=true but no Chromium on PATH");
-        eprintln!("SKIPPED report_browser: no chromium on PATH (Debian: apt-get install chromium)");
-        return;
+        return common::skip("tests/exports/report_browser.rs (its self-check)", NO_BROWSER);
     };
     let dir = tempfile::tempdir().unwrap();
     let page = dir.path().join("bad.html");

@@ -17,7 +17,7 @@ use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyTuple};
 use smithwalk::engine::detector::{Detector, Grid};
 use smithwalk::engine::run::{CaseResult, Estimator, Shard};
 use smithwalk::io::schema::{self, Column};
-use smithwalk::setup::config::{Config, ConfigError, Model};
+use smithwalk::setup::config::{Config, ConfigError, Model, shorten};
 use smithwalk::{RunOptions, Simulation};
 
 /// The message the command line prints for an error (`error: {e:#}` without the prefix).
@@ -45,31 +45,76 @@ fn load_config(source: &Bound<'_, PyAny>, kind: &str) -> PyResult<Config> {
     let parsed = match kind {
         "path" => Config::load(Path::new(&source.extract::<String>()?)),
         "toml" => Config::parse(&source.extract::<String>()?),
-        "dict" => match to_toml(source, "") {
-            Ok(toml::Value::Table(table)) => Config::from_table(&table),
-            Ok(_) => return Err(PyValueError::new_err("config <dict> is not valid: not a dict")),
-            Err(e) => Err(e.in_source("<dict>")),
-        },
+        "dict" => return load_dict(source),
         _ => return Err(PyValueError::new_err(format!("unknown config kind {kind:?}"))),
     };
     parsed.map_err(config_error)
 }
 
-/// A Python value of a config dict at `field` as TOML: dicts, lists and tuples, booleans,
-/// integers, floats (NaN and infinities too, for the checks to name them) and strings; numpy
-/// scalars and arrays by their `tolist()`.
-fn to_toml(value: &Bound<'_, PyAny>, field: &str) -> Result<toml::Value, ConfigError> {
+/// Reads and validates a config dict. Its `seed` may be any integer from 0 to 2^64 - 1, Python's
+/// or numpy's, as the command line's `--seed`: TOML integers stop at 2^63 - 1, so a larger seed
+/// is taken out of the table and set on the parsed config.
+fn load_dict(source: &Bound<'_, PyAny>) -> PyResult<Config> {
+    let Ok(dict) = source.cast::<PyDict>() else {
+        return Err(PyValueError::new_err("config <dict> is not valid: not a dict"));
+    };
+    let large_seed = match dict.get_item("seed")? {
+        Some(seed) if !seed.is_instance_of::<PyBool>() => seed.extract::<u64>().ok().filter(|&s| s > i64::MAX as u64),
+        _ => None,
+    };
+    let source = match large_seed {
+        Some(_) => {
+            let copy = dict.copy()?;
+            copy.del_item("seed")?;
+            copy
+        }
+        None => dict.clone(),
+    };
+    let table = match to_toml(source.as_any(), "", 0) {
+        Ok(toml::Value::Table(table)) => table,
+        Ok(_) => return Err(PyValueError::new_err("config <dict> is not valid: not a dict")),
+        Err(e) => return Err(config_error(e.in_source("<dict>"))),
+    };
+    let mut config = Config::from_table(&table).map_err(config_error)?;
+    if let Some(seed) = large_seed {
+        config.seed = seed;
+    }
+    Ok(config)
+}
+
+/// The deepest nesting of a config dict's values: a config's deepest value, an `[alpha_x,
+/// alpha_y]` pair in a list of roughnesses, is 3 deep. The bound also ends a dict or list that
+/// holds itself, which would otherwise recurse until the stack overflows.
+const MAX_DEPTH: usize = 16;
+
+/// A Python value of a config dict at `field`, `depth` tables and lists deep, as TOML: dicts,
+/// lists and tuples, booleans, integers, floats (NaN and infinities too, for the checks to name
+/// them) and strings; numpy scalars and arrays by their `tolist()`.
+fn to_toml(value: &Bound<'_, PyAny>, field: &str, depth: usize) -> Result<toml::Value, ConfigError> {
     let invalid = |allowed: &str| ConfigError::Invalid {
         field: field.to_string(),
-        value: value.repr().map_or_else(|_| "?".to_string(), |r| r.to_string()),
+        value: value.repr().map_or_else(|_| "?".to_string(), |r| shorten(&r.to_string_lossy(), 60)),
         allowed: allowed.to_string(),
     };
+    if depth > MAX_DEPTH {
+        return Err(ConfigError::Invalid {
+            field: field.to_string(),
+            value: "a value nested deeper".to_string(),
+            allowed: format!(
+                "dicts and lists nested at most {MAX_DEPTH} deep (a config's deepest value is 3 deep; a dict or list \
+                 that holds itself is never allowed)"
+            ),
+        });
+    }
     if let Ok(dict) = value.cast::<PyDict>() {
         let mut table = toml::Table::new();
-        for (key, item) in dict.iter() {
+        // A snapshot of the items: the dict may change while its values are converted.
+        for item in dict.items().iter() {
+            let (key, item): (Bound<'_, PyAny>, Bound<'_, PyAny>) =
+                item.extract().map_err(|_| invalid("a dict of key-value pairs"))?;
             let key: String = key.extract().map_err(|_| invalid("a dict with string keys"))?;
             let inner = if field.is_empty() { key.clone() } else { format!("{field}.{key}") };
-            table.insert(key, to_toml(&item, &inner)?);
+            table.insert(key, to_toml(&item, &inner, depth + 1)?);
         }
         return Ok(toml::Value::Table(table));
     }
@@ -77,7 +122,7 @@ fn to_toml(value: &Bound<'_, PyAny>, field: &str) -> Result<toml::Value, ConfigE
         let items = value.try_iter().map_err(|_| invalid("a list"))?;
         let values = items
             .enumerate()
-            .map(|(i, item)| to_toml(&item.map_err(|_| invalid("a list"))?, &format!("{field}[{i}]")))
+            .map(|(i, item)| to_toml(&item.map_err(|_| invalid("a list"))?, &format!("{field}[{i}]"), depth + 1))
             .collect::<Result<_, _>>()?;
         return Ok(toml::Value::Array(values));
     }
@@ -85,7 +130,9 @@ fn to_toml(value: &Bound<'_, PyAny>, field: &str) -> Result<toml::Value, ConfigE
         return Ok(toml::Value::Boolean(value.is_truthy().map_err(|_| invalid("a boolean"))?));
     }
     if value.is_instance_of::<PyInt>() {
-        return value.extract().map(toml::Value::Integer).map_err(|_| invalid("an integer from -2^63 to 2^63 - 1"));
+        // `seed` from 2^63 to 2^64 - 1 never gets here ([`load_dict`]).
+        let range = if field == "seed" { "an integer from 0 to 2^64 - 1" } else { "an integer from -2^63 to 2^63 - 1" };
+        return value.extract().map(toml::Value::Integer).map_err(|_| invalid(range));
     }
     if value.is_instance_of::<PyFloat>() {
         return value.extract().map(toml::Value::Float).map_err(|_| invalid("a number"));
@@ -94,7 +141,7 @@ fn to_toml(value: &Bound<'_, PyAny>, field: &str) -> Result<toml::Value, ConfigE
         return Ok(toml::Value::String(text));
     }
     match value.call_method0("tolist") {
-        Ok(plain) if !plain.is(value) => to_toml(&plain, field),
+        Ok(plain) if !plain.is(value) => to_toml(&plain, field, depth + 1),
         _ => Err(invalid("a number, a string, a boolean, a list or a dict (leave the key out for its default)")),
     }
 }

@@ -50,7 +50,7 @@ use crate::analysis::models::{
 use crate::atomic::write_atomically;
 use crate::io::rundir::{BinValue, LobeId, RunDir};
 use crate::io::schema;
-use crate::setup::config::Model;
+use crate::setup::config::{MAX_PATHS, Model};
 
 /// What `smithwalk compare` is asked to do.
 #[derive(Clone, Debug)]
@@ -86,9 +86,9 @@ impl CompareOptions {
 
     fn validate(&self) -> Result<()> {
         if let Some(p) = self.paths
-            && p < 2
+            && !(2..=MAX_PATHS).contains(&p)
         {
-            bail!("`--paths` = {p} is not allowed: at least 2 photons per case for the Monte Carlo models");
+            bail!("`--paths` = {p} is not allowed: from 2 to 10^15 photons per case for the Monte Carlo models");
         }
         if self.threads == Some(0) {
             bail!("`--threads` = 0 is not allowed: at least 1 thread");

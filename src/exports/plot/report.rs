@@ -77,12 +77,12 @@ struct Comparison {
     rejected: Option<bool>,
 }
 
-fn read_comparisons(run_dir: &Path) -> Result<Option<Vec<Comparison>>> {
+fn read_comparisons(run_dir: &Path, limit: u64) -> Result<Option<Vec<Comparison>>> {
     let path = run_dir.join(schema::COMPARE.file);
     if !path.exists() {
         return Ok(None);
     }
-    let table = Table::read(&path)?;
+    let table = Table::read(&path, limit)?;
     let column = |c| table.column(c);
     let optional = |c| table.optional(c);
     let (case, model, order, hemisphere) =
@@ -246,7 +246,7 @@ pub(super) fn page(
             String::new()
         }
     );
-    if let Some(rows) = read_comparisons(run_dir)? {
+    if let Some(rows) = read_comparisons(run_dir, run.table_limit)? {
         comparison_tables(&mut html, run, &rows);
     }
     let mut number = 0;

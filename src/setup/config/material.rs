@@ -68,13 +68,22 @@ fn hammon_f0() -> Channels {
 }
 
 impl MaterialConfig {
+    /// The user's `name`, if given.
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            MaterialConfig::Conductor { name, .. }
+            | MaterialConfig::Dielectric { name, .. }
+            | MaterialConfig::Diffuse { name, .. }
+            | MaterialConfig::Hammon { name, .. } => name.as_deref(),
+        }
+    }
+
     /// A short label for tables: the user's `name`, or the kind and its parameters.
     pub fn label(&self) -> String {
+        if let Some(name) = self.name() {
+            return name.to_string();
+        }
         match self {
-            MaterialConfig::Conductor { name: Some(n), .. }
-            | MaterialConfig::Dielectric { name: Some(n), .. }
-            | MaterialConfig::Diffuse { name: Some(n), .. }
-            | MaterialConfig::Hammon { name: Some(n), .. } => n.clone(),
             MaterialConfig::Conductor { fresnel, f0, eta, k, .. } => match fresnel {
                 FresnelKind::None => "conductor F=1".into(),
                 FresnelKind::Schlick => format!("conductor schlick f0={}", f0.unwrap_or(Channels::Mono(f64::NAN))),

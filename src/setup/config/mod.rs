@@ -63,6 +63,9 @@ pub const MAX_PATHS: u64 = 1_000_000_000_000_000;
 /// The most cases a sweep may expand to.
 pub const MAX_CASES: u64 = 1_000_000;
 
+/// The longest material `name`, in characters: a label for tables, figures and the report.
+pub const MAX_NAME_CHARS: usize = 100;
+
 fn default_seed() -> u64 {
     1
 }
@@ -83,7 +86,7 @@ fn not_a_table_config(document: &toml::Table) -> Result<(), ConfigError> {
 impl Config {
     /// Reads, parses and validates a TOML configuration file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path)
+        let text = crate::input::read_to_string(path, crate::input::MAX_CONFIG_BYTES)
             .map_err(|cause| ConfigError::Read { path: path.display().to_string(), cause })?;
         Self::parse(&text).map_err(|e| e.in_source(&path.display().to_string()))
     }
@@ -141,6 +144,15 @@ impl Config {
         }
         for (field, m) in self.material_fields() {
             physics::material(&field, m)?;
+            if let Some(name) = m.name()
+                && name.chars().count() > MAX_NAME_CHARS
+            {
+                return Err(invalid(
+                    format!("{field}.name"),
+                    format!("a name of {} characters", name.chars().count()),
+                    format!("a label of at most {MAX_NAME_CHARS} characters (it heads table columns and figures)"),
+                ));
+            }
         }
         let i = &self.incident;
         if i.theta_deg.is_some() && i.theta_rad.is_some() {

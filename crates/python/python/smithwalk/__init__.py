@@ -98,7 +98,8 @@ def _config_source(config):
 
 
 def _unsigned(name, value, *, minimum=0):
-    """An optional integer argument of at least `minimum`, checked with the command line's wording."""
+    """An optional integer argument from `minimum` to 2^64 - 1 (Python's or numpy's), checked
+    with the command line's wording."""
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
@@ -106,6 +107,8 @@ def _unsigned(name, value, *, minimum=0):
     value = int(value)
     if value < minimum:
         raise ValueError(f"`{name}` = {value} is not allowed: an integer >= {minimum}")
+    if value > 2**64 - 1:
+        raise ValueError(f"`{name}` = {value} is not allowed: an integer from {minimum} to 2^64 - 1")
     return value
 
 
