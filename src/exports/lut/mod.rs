@@ -145,11 +145,12 @@ fn assemble(config: &LutConfig, record: TableRecord, sim: &Simulation) -> Lut {
     for quantity in config.quantities() {
         let s = sides.iter().position(|&x| x == quantity.side).unwrap_or(0);
         let (mut e, mut e_stderr, mut avg, mut avg_stderr) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        for slice in 0..slices {
+        // One material per eta slice (one slice without eta).
+        for (slice, material) in materials.iter().enumerate() {
             for walked_a in &walked {
                 // Order 1 holds all of a flat surface's albedo (slot 1 is "1plus" when max_order = 1).
                 let flat = |m: usize| {
-                    let value = flat::albedo(&materials[slice], quantity.side, quantity.hemisphere, incidence(m));
+                    let value = flat::albedo(material, quantity.side, quantity.hemisphere, incidence(m));
                     (if quantity.slot <= 1 { value } else { 0.0 }, 0.0)
                 };
                 let albedo = |m: usize| match walked_a {
