@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use serde::Serialize;
 
-use super::{Lut, Quantity, QuantityTable};
+use super::config::MU_GRAZING;
+use super::tables::{Lut, Quantity, QuantityTable};
 use crate::atomic::write_atomically;
 use crate::io::output::name;
 use crate::io::table_record::{Nodes, TableRecord};
@@ -129,7 +130,7 @@ fn provenance(lut: &Lut) -> String {
         Nodes::Edges => format!(
             "nodes on the end points mu_i = i / (n_mu - 1) (cos theta_i; mu = 0 holds E at mu = {}, alpha = 0 the \
              flat surface's exact albedo)",
-            super::MU_GRAZING
+            MU_GRAZING
         ),
     };
     format!(
