@@ -7,12 +7,19 @@
 //! and clamp-to-edge addressing: `E` bilinearly in `(alpha, mu)`, `E_avg` linearly in `alpha`,
 //! and outside the nodes' range each coordinate is clamped to its first or last node (the
 //! table's edge values are held; nothing is extrapolated).
+//!
+//! A table `smithwalk lut` made carries its record (`lut.json` beside `lut.csv`: the NDF, the
+//! facet, the alpha range); a run is refused the table of another NDF, facet or range
+//! ([`AlbedoTable::check`]). A table of your own without a record is taken on trust.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
 use crate::input;
+use crate::io::output::name;
+use crate::io::table_record::{TableKind, TableRecord};
+use crate::setup::cases::Case;
 
 /// The quantity of `lut.csv` that the compensation models need: reflection, order 1 (single
 /// scattering) of the F = 1 conductor table.
@@ -32,6 +39,8 @@ pub struct AlbedoTable {
     /// Increasing alpha nodes of `E_avg`.
     avg_alpha: Vec<f64>,
     e_avg: Vec<f64>,
+    /// What the table is, from the `.json` beside the `E` file (`lut.json`), if there is one.
+    pub record: Option<TableRecord>,
 }
 
 /// `values` (at increasing `nodes`, at least 2) interpolated linearly at `x`, clamped to the
@@ -148,7 +157,36 @@ impl AlbedoTable {
             bail!("{}: an alpha is given twice", avg_path.display());
         }
         let e_avg = rows_avg.iter().map(|r| r[1]).collect();
-        Ok(AlbedoTable { path: e_path, alpha, mu, e, avg_alpha, e_avg })
+        let record_path = e_path.with_extension("json");
+        let record = record_path.exists().then(|| TableRecord::read(&record_path)).transpose()?;
+        Ok(AlbedoTable { path: e_path, alpha, mu, e, avg_alpha, e_avg, record })
+    }
+
+    /// Refuses the table for `case` (one the compensation models apply to: a conductor on an
+    /// isotropic surface with the true Smith Lambda and visible normals) when its record says
+    /// it was made for another facet than the conductor with F = 1, another NDF or Smith
+    /// variant, or a range of alpha without the case's: one line naming both.
+    pub fn check(&self, case: &Case) -> Result<()> {
+        let Some(r) = &self.record else { return Ok(()) };
+        let alpha = case.roughness().x;
+        let [lo, hi] = r.alpha_range;
+        let ndf = case.surface.ndf.name();
+        let smith = name(&r.smith);
+        let matches =
+            r.table == TableKind::Conductor && name(&r.ndf) == ndf && smith == "exact" && (lo..=hi).contains(&alpha);
+        if matches {
+            return Ok(());
+        }
+        bail!(
+            "--albedo-table {}: the table is for {} {} facets ({} Smith), alpha in [{lo}, {hi}] (its lut.json), but case {} \
+             of the run is {ndf}, alpha {alpha}: the compensation models read the F = 1 conductor table of the run's NDF \
+             over a range with its alpha (`smithwalk lut`, docs/compensation.md)",
+            self.path.display(),
+            name(&r.ndf),
+            name(&r.table),
+            smith,
+            case.index
+        )
     }
 
     /// `E` at the `mu` nodes and `E_avg`, at roughness `alpha`: the rows of `E` interpolated
@@ -167,8 +205,12 @@ impl AlbedoTable {
 
     /// A one-line description for the report.
     pub fn describe(&self) -> String {
+        let made = match &self.record {
+            Some(r) => format!("{} {}", name(&r.ndf), name(&r.table)),
+            None => "without a lut.json: NDF and facet unchecked".to_string(),
+        };
         format!(
-            "E(mu) and E_avg from the table {} ({} alpha x {} mu nodes, bilinear, clamped to alpha [{}, {}], mu [{}, {}])",
+            "E(mu) and E_avg from the table {} ({made}; {} alpha x {} mu nodes, bilinear, clamped to alpha [{}, {}], mu [{}, {}])",
             self.path.display(),
             self.alpha.len(),
             self.mu.len(),

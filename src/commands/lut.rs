@@ -14,7 +14,7 @@ pub fn lut(config_path: &Path, paths: Option<u64>, threads: Option<usize>, out: 
     let mut config = LutConfig::load(config_path)?;
     if let Some(p) = paths {
         // The file is valid (`load` checked it), so an error now is the option's.
-        config.paths = p;
+        config.table.paths = p;
         config.validate().map_err(|e| e.from_option("--paths"))?;
     }
     check_threads(threads)?;

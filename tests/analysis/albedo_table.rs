@@ -230,3 +230,97 @@ fn malformed_tables_are_refused_and_nothing_is_written() {
     assert!(String::from_utf8_lossy(&output.stderr).contains("only read by the models kulla-conty"));
     assert!(!run.join("models.csv").exists(), "something was written");
 }
+
+/// `smithwalk compare --albedo-table` refuses a table whose `lut.json` says it was made for
+/// another NDF, another facet than the F = 1 conductor, or an alpha range without the run's
+/// alpha: one line naming the table's and the run's, exit status 1, nothing written. The
+/// matching table, and a table without a `lut.json` (a user's own), are read.
+#[test]
+fn a_table_made_for_another_ndf_facet_or_range_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let run_of = |name: &str, ndf: &str| {
+        common::run_config(
+            dir.path(),
+            name,
+            &format!(
+                "paths = 1000\n[surface]\nndf = \"{ndf}\"\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\n\
+                 theta_deg = 0\n[detector]\ncos_theta_bins = 2\nphi_bins = 2\nmax_order = 2\n"
+            ),
+        )
+        .0
+    };
+    let (ggx, beckmann) = (run_of("ggx", "ggx"), run_of("beckmann", "beckmann"));
+    let lut: String = [(0.25, 0.25, 0.9), (0.25, 0.75, 0.95), (0.75, 0.25, 0.5), (0.75, 0.75, 0.7)]
+        .iter()
+        .map(|(a, m, e)| format!("R_1,outside,R,1,,{a},{m},{e},0,1000\n"))
+        .collect();
+    let table = |record: Option<(&str, &str, [f64; 2])>| {
+        let table = tempfile::tempdir().unwrap();
+        let head = "quantity,side,hemisphere,order,eta,alpha,mu,E,E_stderr,photons\n";
+        std::fs::write(table.path().join("lut.csv"), format!("{head}{lut}")).unwrap();
+        std::fs::write(
+            table.path().join("lut_avg.csv"),
+            "quantity,side,hemisphere,order,eta,alpha,E_avg,E_avg_stderr\nR_1,outside,R,1,,0.25,0.9,0\nR_1,outside,R,1,,0.75,0.6,0\n",
+        )
+        .unwrap();
+        if let Some((kind, ndf, [lo, hi])) = record {
+            // The record as `smithwalk lut` writes it (data/lut/ggx-conductor/lut.json's form).
+            let json = format!(
+                "{{\"config\": {{\"table\": \"{kind}\", \"ndf\": \"{ndf}\", \"alpha_range\": [{lo:?}, {hi:?}], \
+                 \"eta_range\": [1.0, 3.0], \"max_order\": 4, \"avg_nodes\": 16, \"paths\": 1000, \"seed\": 1}}}}"
+            );
+            std::fs::write(table.path().join("lut.json"), json).unwrap();
+        }
+        table
+    };
+    let compare = |run: &std::path::Path, table: &std::path::Path| {
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_smithwalk"))
+            .args(["compare", run.to_str().unwrap(), "--models", "kulla-conty", "--albedo-table"])
+            .arg(table)
+            .output()
+            .unwrap();
+        (
+            output.status.code(),
+            String::from_utf8_lossy(&output.stderr).to_string(),
+            String::from_utf8_lossy(&output.stdout).to_string(),
+        )
+    };
+    let refused = |run: &std::path::Path, record: (&str, &str, [f64; 2]), expected: &[&str]| {
+        let t = table(Some(record));
+        let (code, stderr, _) = compare(run, t.path());
+        assert_eq!(code, Some(1), "{record:?}: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+        for e in expected {
+            assert!(stderr.contains(e), "{stderr:?} lacks {e:?}");
+        }
+        assert!(!run.join("models.csv").exists() && !run.join("compare.csv").exists(), "something was written");
+    };
+    refused(
+        &beckmann,
+        ("conductor", "ggx", [0.0, 1.0]),
+        &["the table is for ggx conductor facets", "is beckmann, alpha 0.5"],
+    );
+    refused(&ggx, ("hammon", "ggx", [0.0, 1.0]), &["ggx hammon facets", "F = 1 conductor table"]);
+    refused(&ggx, ("conductor", "ggx", [0.6, 1.0]), &["alpha in [0.6, 1]", "is ggx, alpha 0.5"]);
+    refused(&beckmann, ("conductor", "ggx", [0.6, 1.0]), &["the table is for ggx"]);
+    let matching = table(Some(("conductor", "beckmann", [0.0, 1.0])));
+    let (code, stderr, report) = compare(&beckmann, matching.path());
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(report.contains("beckmann conductor; 2 alpha x 2 mu nodes"), "{report}");
+    let own = table(None);
+    let (code, stderr, report) = compare(&ggx, own.path());
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(report.contains("without a lut.json: NDF and facet unchecked"), "{report}");
+}
+
+/// The committed table's `lut.json`, written before the record gained fields, reads.
+#[test]
+fn the_committed_tables_record_reads() {
+    use smithwalk::io::table_record::{Nodes, TableKind, TableRecord};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/lut/ggx-conductor/lut.json");
+    let record = TableRecord::read(&path).unwrap();
+    assert_eq!(
+        (record.table, record.ndf, record.alpha_range, record.nodes),
+        (TableKind::Conductor, NdfKind::Ggx, [0.0, 1.0], Nodes::Cells)
+    );
+}

@@ -7,6 +7,9 @@
 //!   family level 0.01 over the cells of each test; E_avg of order 1 against an adaptive
 //!   Gauss–Kronrod integral over mu of the same quadrature albedo;
 //! - dielectric: R + T of all orders is 1 from both sides (energy is conserved);
+//! - edge nodes: alpha = 0 is the flat interface (Fresnel from Snell's law, independent of the
+//!   code's formula), the walk's limit; mu = 0 is the walk at grazing `MU_GRAZING`;
+//! - configs: bad values, the flat form of before and swept values are refused in one line;
 //! - the files: the C header compiled by the system C compiler, the Rust source compiled by
 //!   rustc, and the OpenEXR image decoded, all hold the values of lut.csv.
 
@@ -18,8 +21,13 @@ use smithwalk::exports::lut::{Lut, LutConfig, build};
 use smithwalk::setup::cases::{Case, expand};
 
 fn lut(toml: &str) -> Lut {
-    let config: LutConfig = toml::from_str(toml).expect("test table config parses");
+    let config = LutConfig::parse(toml).expect("test table config parses");
     build(&config, Some(2), false).expect("table builds")
+}
+
+/// A table config of facet `kind` (with more `[material]` keys in `material`) and grid `table`.
+fn form(material: &str, table: &str) -> String {
+    format!("[material]\nkind = {material}\n[table]\n{table}")
 }
 
 /// The case of the table's run at (alpha, mu) for the first material and side `outside`.
@@ -55,7 +63,7 @@ fn z_limit(cells: usize) -> f64 {
 fn conductor_all_orders_are_one_and_orders_add_up() {
     // 4 x 3 cells x 20 000 photons (+ 16 E_avg nodes per alpha), including grazing mu = 1/8.
     let lut =
-        lut("table = \"conductor\"\nmu = 4\nalpha = 3\nalpha_range = [0.0, 1.5]\navg_nodes = 16\npaths = 20000\n");
+        lut(&form("\"conductor\"", "mu = 4\nalpha = 3\nalpha_range = [0.0, 1.5]\navg_nodes = 16\npaths = 20000\n"));
     let all = lut.table("R_all").unwrap();
     assert!(all.e.iter().all(|&e| (e - 1.0).abs() < 1e-12), "{:?}", all.e);
     assert!(all.e_stderr.iter().all(|&s| s < 1e-9), "{:?}", all.e_stderr);
@@ -77,7 +85,8 @@ fn order_one_matches_single_scattering_quadrature() {
     // GGX and Beckmann conductor F = 1: 4 x 2 cells each at 400 000 photons.
     for ndf in ["ggx", "beckmann"] {
         let lut = lut(&format!(
-            "table = \"conductor\"\nndf = \"{ndf}\"\nmu = 4\nalpha = 2\nalpha_range = [0.2, 1.0]\navg_nodes = 8\npaths = 400000\n"
+            "[surface]\nndf = \"{ndf}\"\n{}",
+            form("\"conductor\"", "mu = 4\nalpha = 2\nalpha_range = [0.2, 1.0]\navg_nodes = 8\npaths = 400000\n")
         ));
         let e1 = lut.table("R_1").unwrap();
         let limit = z_limit(e1.e.len() + lut.alpha.len());
@@ -104,9 +113,10 @@ fn order_one_matches_single_scattering_quadrature() {
 #[test]
 fn dielectric_tables_conserve_energy_and_match_single_scattering() {
     // 3 mu x 2 alpha x 2 eta, both sides, 200 000 photons per cell.
-    let lut = lut(
-        "table = \"dielectric\"\nmu = 3\nalpha = 2\nalpha_range = [0.2, 1.0]\neta = 2\neta_range = [1.2, 2.0]\navg_nodes = 6\npaths = 200000\n",
-    );
+    let lut = lut(&form(
+        "\"dielectric\"",
+        "mu = 3\nalpha = 2\nalpha_range = [0.2, 1.0]\neta = 2\neta_range = [1.2, 2.0]\navg_nodes = 6\npaths = 200000\n",
+    ));
     for side in ["outside", "inside"] {
         let (r, t) = (lut.table(&format!("{side}_R_all")).unwrap(), lut.table(&format!("{side}_T_all")).unwrap());
         for i in 0..r.e.len() {
@@ -135,9 +145,10 @@ fn dielectric_tables_conserve_energy_and_match_single_scattering() {
 
 #[test]
 fn hammon_order_one_matches_single_scattering() {
-    let lut = lut(
-        "table = \"hammon\"\nf0 = 0.04\nalbedo = 0.8\nmu = 3\nalpha = 2\nalpha_range = [0.2, 1.0]\navg_nodes = 4\npaths = 200000\n",
-    );
+    let lut = lut(&form(
+        "\"hammon\"\nf0 = 0.04\nalbedo = 0.8",
+        "mu = 3\nalpha = 2\nalpha_range = [0.2, 1.0]\navg_nodes = 4\npaths = 200000\n",
+    ));
     let e1 = lut.table("R_1").unwrap();
     let limit = z_limit(e1.e.len());
     for (a, &alpha) in lut.alpha.iter().enumerate() {
@@ -152,9 +163,10 @@ fn hammon_order_one_matches_single_scattering() {
 
 #[test]
 fn a_precision_target_stops_cells_early() {
-    let lut = lut(
-        "table = \"conductor\"\nmu = 2\nalpha = 1\nalpha_range = [0.4, 0.6]\navg_nodes = 2\npaths = 50_000_000\ntarget_stderr = 1e-3\n",
-    );
+    let lut = lut(&form(
+        "\"conductor\"",
+        "mu = 2\nalpha = 1\nalpha_range = [0.4, 0.6]\navg_nodes = 2\npaths = 50_000_000\ntarget_stderr = 1e-3\n",
+    ));
     assert!(lut.photons.iter().all(|&n| n < 50_000_000), "{:?}", lut.photons);
     for t in &lut.tables {
         assert!(t.e_stderr.iter().all(|&s| s <= 1e-3), "{}: {:?}", t.quantity.name, t.e_stderr);
@@ -173,17 +185,21 @@ fn load_error(toml: &str) -> (String, String) {
 
 #[test]
 fn bad_table_configs_name_the_field() {
+    let conductor = "\"conductor\"";
     let cases = [
-        ("table = \"conductor\"\nmu = 0\npaths = 10\n", "`mu` = 0"),
-        ("table = \"conductor\"\neta = 4\npaths = 10\n", "`eta` = 4"),
-        ("table = \"conductor\"\nalpha_range = [0.5, 0.2]\npaths = 10\n", "`alpha_range`"),
-        ("table = \"dielectric\"\neta = 1\neta_range = [0.5, 1.5]\npaths = 10\n", "`eta_range`"),
-        ("table = \"hammon\"\nf0 = 1.5\npaths = 10\n", "`f0` = 1.5"),
-        ("table = \"conductor\"\nf0 = 0.5\npaths = 10\n", "`f0` = 0.5"),
-        ("table = \"conductor\"\ntarget_stderr = -1\npaths = 10\n", "`target_stderr` = -1"),
-        ("table = \"conductor\"\npaths = 1\n", "`paths` = 1"),
+        (form(conductor, "mu = 0\npaths = 10\n"), "`table.mu` = 0"),
+        (form(conductor, "eta = 4\npaths = 10\n"), "`table.eta` = 4"),
+        (form(conductor, "alpha_range = [0.5, 0.2]\npaths = 10\n"), "`table.alpha_range`"),
+        (form("\"dielectric\"", "eta = 1\neta_range = [0.5, 1.5]\npaths = 10\n"), "`table.eta_range`"),
+        (form("\"hammon\"\nf0 = 1.5", "paths = 10\n"), "`material.f0` = 1.5"),
+        (form("\"conductor\"\nfresnel = \"schlick\"\nf0 = 0.5", "paths = 10\n"), "`material.fresnel` = \"schlick\""),
+        (form("\"diffuse\"", "paths = 10\n"), "`material.kind` = \"diffuse\""),
+        (form(conductor, "target_stderr = -1\npaths = 10\n"), "`table.target_stderr` = -1"),
+        (form(conductor, "paths = 1\n"), "`table.paths` = 1"),
+        (form(conductor, "nodes = \"edges\"\nmu = 1\npaths = 10\n"), "`table.mu` = 1"),
+        (format!("[surface]\nndf = [\"ggx\", \"beckmann\"]\n{}", form(conductor, "paths = 10\n")), "`surface.ndf`"),
     ];
-    for (toml, field) in cases {
+    for (toml, field) in &cases {
         let (err, prefix) = load_error(toml);
         assert!(err.contains(field) && err.contains("not allowed"), "{toml}: {err}");
         // Like a run's config, a table's names the file the value is in.
@@ -193,13 +209,15 @@ fn bad_table_configs_name_the_field() {
 
 #[test]
 fn a_table_config_that_does_not_read_gets_one_line_naming_the_key() {
+    let conductor = "\"conductor\"";
     let cases = [
-        ("table = \"conductor\"\nmu_nodes = 3\npaths = 10\n", "`mu_nodes` is not a known key (line 2)"),
-        ("table = \"conductor\"\nmu = \"x\"\npaths = 10\n", "`mu` = \"x\" is not allowed (line 2)"),
-        ("table = \"metal\"\npaths = 10\n", "`table` = \"metal\" is not allowed (line 1)"),
-        ("paths = 10\n", "`table` is missing: the table config's facet, \"conductor\", \"dielectric\" or \"hammon\""),
+        (form(conductor, "mu_nodes = 3\npaths = 10\n"), "`table.mu_nodes` is not a known key (line 4)"),
+        (form(conductor, "mu = \"x\"\npaths = 10\n"), "`table.mu` = \"x\" is not allowed (line 4)"),
+        (form("\"metal\"", "paths = 10\n"), "`material.kind` = \"metal\" is not allowed (line 2)"),
+        ("[material]\nkind = \"conductor\"\n".to_string(), "`[table]` is missing: a table with the grid"),
+        (form(conductor, "nodes = \"corners\"\npaths = 10\n"), "`table.nodes` = \"corners\" is not allowed (line 4)"),
     ];
-    for (toml, expected) in cases {
+    for (toml, expected) in &cases {
         let (err, prefix) = load_error(toml);
         assert!(err.starts_with(&prefix), "{toml}: {err}");
         assert!(err.contains(expected) && !err.contains('\n'), "{toml}: {err}");
@@ -210,7 +228,7 @@ fn a_table_config_that_does_not_read_gets_one_line_naming_the_key() {
 fn a_bad_photon_count_on_the_command_line_is_named_as_typed() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("t.toml");
-    std::fs::write(&path, "table = \"conductor\"\nmu = 2\nalpha = 2\npaths = 10\n").unwrap();
+    std::fs::write(&path, form("\"conductor\"", "mu = 2\nalpha = 2\npaths = 10\n")).unwrap();
     let out_dir = dir.path().join("out");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_smithwalk"))
         .args(["lut", path.to_str().unwrap(), "--paths", "1", "--out", out_dir.to_str().unwrap()])
@@ -235,7 +253,7 @@ fn csv_values(dir: &std::path::Path, quantity: &str) -> Vec<f32> {
 
 #[test]
 fn c_header_rust_source_and_exr_hold_the_csv_values() {
-    let lut = lut("table = \"dielectric\"\nmu = 3\nalpha = 2\neta = 2\nmax_order = 2\navg_nodes = 2\npaths = 2000\n");
+    let lut = lut(&form("\"dielectric\"", "mu = 3\nalpha = 2\neta = 2\nmax_order = 2\navg_nodes = 2\npaths = 2000\n"));
     let dir = tempfile::tempdir().unwrap();
     smithwalk::exports::lut::write(&lut, dir.path()).unwrap();
     let expected = csv_values(dir.path(), "inside_T_all");
@@ -287,4 +305,140 @@ fn c_header_rust_source_and_exr_hold_the_csv_values() {
     let channel = layer.channel_data.list.iter().find(|c| c.name == *"inside_T_all").expect("channel");
     let values: Vec<f32> = channel.sample_data.values_as_f32().collect();
     assert_eq!(values, expected);
+}
+
+#[test]
+fn a_table_config_in_the_flat_form_of_before_gets_one_line_naming_the_new_form() {
+    // configs/lut-conductor.toml as it was written before [surface], [material] and [table].
+    let old = "table = \"conductor\"\nndf = \"ggx\"\nmu = 32\nalpha = 32\nalpha_range = [0.0, 1.0]\nmax_order = 4\n\
+               paths = 4_000_000\ntarget_stderr = 2e-4\n";
+    let (err, prefix) = load_error(old);
+    assert!(err.starts_with(&prefix) && !err.contains('\n'), "{err}");
+    for part in [
+        "form before",
+        "`table`, `ndf`, `mu`",
+        "[surface] ndf",
+        "[material] kind",
+        "into [table]",
+        "configs/lut-*.toml",
+    ] {
+        assert!(err.contains(part), "{part}: {err}");
+    }
+}
+
+#[test]
+fn a_value_the_table_sweeps_is_refused_in_surface_and_material() {
+    let cases = [
+        (
+            format!("[surface]\nalpha = 0.5\n{}", form("\"conductor\"", "paths = 10\n")),
+            "`surface.alpha` = 0.5 is not allowed (line 2): a table sweeps alpha",
+        ),
+        (
+            form("\"dielectric\"\neta = 1.5", "paths = 10\n"),
+            "`material.eta` = 1.5 is not allowed (line 3): a dielectric table sweeps eta",
+        ),
+    ];
+    for (toml, expected) in &cases {
+        let (err, _) = load_error(toml);
+        assert!(err.contains(expected) && !err.contains('\n'), "{toml}: {err}");
+    }
+}
+
+/// The reflectance of a flat interface of relative index `eta` (transmitted side over incident
+/// side) at incidence cosine `mu`, from Snell's law and the s- and p-polarised amplitudes
+/// (Hecht, Optics §4.6.2), unpolarised; 1 under total internal reflection.
+fn fresnel_hecht(eta: f64, mu: f64) -> f64 {
+    let sin_t = (1.0 - mu * mu).sqrt() / eta;
+    if sin_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin_t * sin_t).sqrt();
+    let rs = (mu - eta * cos_t) / (mu + eta * cos_t);
+    let rp = (eta * mu - cos_t) / (eta * mu + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+#[test]
+fn edge_nodes_put_the_flat_surface_at_alpha_0_and_the_ranges_ends_on_nodes() {
+    // Dielectric, nodes on the edges: mu {0, 0.5, 1}, alpha {0, 1e-4}, eta {1.2, 2}; 20 000
+    // photons per walked cell. At alpha = 0 every albedo is the flat interface's exact one, in
+    // order 1; the walk at alpha 1e-4 and mu > 0 must agree with it within its standard error
+    // (the flat surface is the walk's limit). GGX's tails put a share ~ (alpha / s)^2 of the
+    // facets beyond a slope s: from inside at eta 1.2 and mu 0.5, 3.6 deg (s = 0.063) past the
+    // critical angle, 2.5e-6 of them, far below the error ~2e-3 (at alpha 0.004 it was 4e-3
+    // and the walk transmitted 6e-4 where the flat interface reflects all). z two-sided, Sidak
+    // family level 0.01 over the 16 cells compared; a cell whose walk has no spread (total
+    // internal reflection: every photon reflected) must equal the flat value to 1e-9.
+    let lut = lut(&form(
+        "\"dielectric\"",
+        "nodes = \"edges\"\nmu = 3\nalpha = 2\nalpha_range = [0.0, 1e-4]\neta = 2\neta_range = [1.2, 2.0]\n\
+         avg_nodes = 4\npaths = 20000\n",
+    ));
+    assert_eq!(
+        (lut.mu.clone(), lut.alpha.clone(), lut.eta.clone()),
+        (vec![0.0, 0.5, 1.0], vec![0.0, 1e-4], vec![1.2, 2.0])
+    );
+    for t in &lut.tables {
+        let all = t.e.iter().chain(&t.e_stderr).chain(&t.avg).chain(&t.avg_stderr);
+        assert!(all.clone().all(|v| v.is_finite() && (0.0..=1.0).contains(v)), "{}: {:?}", t.quantity.name, t.e);
+    }
+    let limit = z_limit(16);
+    for (s, &eta) in lut.eta.iter().enumerate() {
+        for side in ["outside", "inside"] {
+            let seen = if side == "outside" { eta } else { 1.0 / eta };
+            for (m, &mu) in lut.mu.iter().enumerate() {
+                let (flat, walked) = ((s * 2) * 3 + m, (s * 2 + 1) * 3 + m);
+                let r = fresnel_hecht(seen, mu);
+                for (hemisphere, expected) in [("R", r), ("T", 1.0 - r)] {
+                    for order in ["all", "1"] {
+                        let t = lut.table(&format!("{side}_{hemisphere}_{order}")).unwrap();
+                        assert!(
+                            (t.e[flat] - expected).abs() < 1e-12,
+                            "{side} {hemisphere}_{order} eta {eta} mu {mu}: {}",
+                            t.e[flat]
+                        );
+                        assert_eq!(t.e_stderr[flat], 0.0);
+                    }
+                    for order in ["2", "3", "4plus"] {
+                        assert_eq!(lut.table(&format!("{side}_{hemisphere}_{order}")).unwrap().e[flat], 0.0);
+                    }
+                    let all = lut.table(&format!("{side}_{hemisphere}_all")).unwrap();
+                    if mu > 0.0 {
+                        let off = (all.e[walked] - expected).abs();
+                        assert!(
+                            off <= limit * all.e_stderr[walked] + 1e-9,
+                            "{side} {hemisphere} eta {eta} mu {mu}: walk {} +- {} vs flat {expected}",
+                            all.e[walked],
+                            all.e_stderr[walked]
+                        );
+                    }
+                }
+                assert_eq!(lut.photons[(s * 2) * 3 + m], 0, "the flat surface is not walked");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_node_at_mu_0_holds_the_walk_at_grazing_incidence() {
+    // Conductor F = 1, nodes on the edges: mu {0, 1}, alpha {0.3, 1}, 200 000 photons per cell.
+    // Order 1 at mu = 0 is the walk at mu = MU_GRAZING: against the single-scattering albedo
+    // there by quadrature (docs/theory.md §5). With F = 1 each photon adds 0 or 1 to order 1,
+    // and near grazing almost all add 1 (1 - E_1 ~ 4e-6): the z-score takes the binomial
+    // standard error of the expected albedo, sqrt(E (1 - E) / n), which is not 0 when no photon
+    // of the cell scattered twice. Two-sided, Sidak family level 0.01 over 2 cells.
+    let lut = lut(&form(
+        "\"conductor\"",
+        "nodes = \"edges\"\nmu = 2\nalpha = 2\nalpha_range = [0.3, 1.0]\navg_nodes = 2\npaths = 200000\n",
+    ));
+    assert_eq!(lut.mu, vec![0.0, 1.0]);
+    let e1 = lut.table("R_1").unwrap();
+    let limit = z_limit(2);
+    for (a, &alpha) in lut.alpha.iter().enumerate() {
+        let expected = single_albedo(&case_at(&lut, alpha, smithwalk::exports::lut::MU_GRAZING, None), Hemisphere::R);
+        let se = (expected * (1.0 - expected) / lut.photons[a * 2] as f64).sqrt();
+        let z = (e1.e[a * 2] - expected) / se;
+        assert!(z.abs() < limit, "alpha {alpha}: {} vs {expected} (z = {z:.2})", e1.e[a * 2]);
+        assert_eq!(lut.table("R_all").unwrap().e[a * 2], 1.0);
+    }
 }

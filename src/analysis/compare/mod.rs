@@ -42,7 +42,7 @@ use self::report::{compare_table, models_table, report};
 pub use self::verdict::{DEFAULT_FAMILY_LEVEL, Verdict, is_exact_oracle, is_monte_carlo};
 use self::verdict::{LobeComparison, Value, compare_lobe, verdicts};
 use crate::analysis::albedo_table::AlbedoTable;
-use crate::analysis::compensation::Compensation;
+use crate::analysis::compensation::{Compensation, applies};
 use crate::analysis::external::ExternalModel;
 use crate::analysis::models::{
     MAX_BIN_EVALUATIONS, MAX_EXIT_BIN_EVALUATIONS, hammon_fit_unavailable, single_scattering_unavailable,
@@ -150,6 +150,11 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
         bail!(
             "`--albedo-table` is only read by the models kulla-conty, turquin and fdez-aguera; add one to `--models`"
         );
+    }
+    if let Some(table) = &albedo_table {
+        for case in run.cases.iter().filter(|c| applies(c)) {
+            table.check(case)?;
+        }
     }
     let measured = run.measured()?;
     let summary = run.summary()?;

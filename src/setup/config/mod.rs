@@ -30,7 +30,7 @@ pub use incident::{IncidentConfig, IncidentSide};
 pub use material::{FresnelKind, MaterialConfig};
 pub use physics::MAX_ALPHA;
 pub use precision::PrecisionConfig;
-pub use reading::{RUN_TABLES, parse_toml, shorten};
+pub use reading::{RUN_TABLES, Supplied, parse_toml, parse_toml_supplied, shorten};
 use reading::{VALUE_CHARS, parse_toml_with, required};
 pub use surface::{HeightKind, NdfKind, NormalsKind, SmithKind, SurfaceConfig};
 use values::non_empty;

@@ -1,14 +1,17 @@
 //! Reading TOML text into configuration types, with errors in the user's terms: one line
 //! naming the field (its dotted path), the value as written and what is allowed, and its line.
 
+use std::borrow::Cow;
+
 use serde::Deserialize;
+use toml::de::{DeTable, DeValue};
 
 use super::compare::Model;
 use super::error::ConfigError;
 use super::material::MaterialConfig;
 
 /// The tables of a run config (`smithwalk run`), every top-level key but `paths` and `seed`; a
-/// table config (`smithwalk lut`) has none of them.
+/// table config (`smithwalk lut`) has `[surface]` and `[material]` of them, and `[table]`.
 pub const RUN_TABLES: [&str; 7] = ["surface", "material", "incident", "detector", "energy", "precision", "compare"];
 
 /// Deserializes TOML text; an error is one line naming the field (its dotted path), the value
@@ -17,16 +20,78 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, Confi
     parse_toml_with(text, true)
 }
 
+/// A key that a config leaves out because another of its tables supplies it: `table.key` is
+/// set to `value` (TOML text) before the configuration types read the document. A `smithwalk
+/// lut` config reads `[surface]` and `[material]` with the run's types, and its grid (`[table]`)
+/// supplies the values it sweeps along an axis. `by` says what supplies the key, for the error
+/// when the text gives it too.
+pub struct Supplied<'a> {
+    pub table: &'a str,
+    pub key: &'a str,
+    pub value: String,
+    pub by: String,
+}
+
+/// [`parse_toml`] of the document with the `supplied` keys set: a supplied key that the text
+/// gives too is refused, one line naming it, its value, its line and what supplies it.
+pub fn parse_toml_supplied<T: serde::de::DeserializeOwned>(
+    text: &str,
+    supplied: &[Supplied],
+) -> Result<T, ConfigError> {
+    read_toml(text, true, supplied)
+}
+
 /// [`parse_toml`], with the errors' line numbers only when `lines` (text made from a dict has
 /// lines the user never saw).
 pub(super) fn parse_toml_with<T: serde::de::DeserializeOwned>(text: &str, lines: bool) -> Result<T, ConfigError> {
+    read_toml(text, lines, &[])
+}
+
+/// Sets the `supplied` keys in the parsed document `root` of `text` (the key's span is its
+/// table's); an error names a supplied key that the text gives too.
+fn supply<'i>(
+    text: &str,
+    root: &mut toml::Spanned<DeTable<'i>>,
+    supplied: &'i [Supplied<'i>],
+    at: impl Fn(std::ops::Range<usize>) -> String,
+) -> Result<(), String> {
+    let span = root.span();
+    for s in supplied {
+        let key = |k: &'i str| toml::Spanned::new(span.clone(), Cow::Borrowed(k));
+        let table = root
+            .get_mut()
+            .entry(key(s.table))
+            .or_insert_with(|| toml::Spanned::new(span.clone(), DeValue::Table(DeTable::default())));
+        let table_span = table.span();
+        let DeValue::Table(entries) = table.get_mut() else { continue };
+        if let Some(given) = entries.get(&key(s.key)) {
+            let value = text.get(given.span()).map_or("?".to_string(), |v| shorten(v, VALUE_CHARS));
+            return Err(format!(
+                "`{}.{}` = {value} is not allowed{}: {}; leave it out",
+                s.table,
+                s.key,
+                at(given.span()),
+                s.by
+            ));
+        }
+        let value =
+            DeValue::parse(&s.value).map_err(|e| format!("supplied `{}.{}`: {}", s.table, s.key, e.message()))?;
+        entries.insert(key(s.key), toml::Spanned::new(table_span, value.into_inner()));
+    }
+    Ok(())
+}
+
+/// Reads `text` (with the `supplied` keys set) into `T`; errors as [`parse_toml_with`] says.
+fn read_toml<T: serde::de::DeserializeOwned>(text: &str, lines: bool, supplied: &[Supplied]) -> Result<T, ConfigError> {
     let parse = |message: String| ConfigError::Parse { path: "<text>".into(), message };
     let shown = |line: Option<usize>| line.filter(|_| lines);
-    let line_of =
-        |e: &toml::de::Error| shown(e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1));
+    let line_at = |start: usize| text[..start.min(text.len())].matches('\n').count() + 1;
+    let line_of = |e: &toml::de::Error| shown(e.span().map(|s| line_at(s.start)));
     let at = |e: &toml::de::Error| at_line(line_of(e));
-    let deserializer = toml::de::Deserializer::parse(text)
+    let mut root = DeTable::parse(text)
         .map_err(|e| parse(format!("not TOML{}: {}", at(&e), shorten(e.message(), MESSAGE_CHARS))))?;
+    supply(text, &mut root, supplied, |span| at_line(shown(Some(line_at(span.start))))).map_err(parse)?;
+    let deserializer = toml::de::Deserializer::from(root);
     serde_path_to_error::deserialize(deserializer).map_err(|e| {
         let field = e.path().to_string();
         let inner = e.inner();
@@ -42,7 +107,8 @@ pub(super) fn parse_toml_with<T: serde::de::DeserializeOwned>(text: &str, lines:
             }
             // At the top level the span is the whole text: no line says where the key belongs.
             (None, Some(k)) if field == "." => {
-                let field = if RUN_TABLES.contains(&k) { format!("[{k}]") } else { k.to_string() };
+                // `[table]` is a `smithwalk lut` config's grid.
+                let field = if RUN_TABLES.contains(&k) || k == "table" { format!("[{k}]") } else { k.to_string() };
                 let allowed = required(k).unwrap_or(allowed);
                 parse(ConfigError::Missing { field, place: String::new(), allowed }.to_string())
             }
@@ -72,7 +138,7 @@ pub(super) fn parse_toml_with<T: serde::de::DeserializeOwned>(text: &str, lines:
 /// is an integer in the field's range, `expected f64` a number.
 fn in_user_terms(field: &str, message: &str) -> String {
     let integer = match without_indices(field).as_str() {
-        "paths" | "compare.paths" => "an integer from 2 to 10^15, e.g. 1000000 or 1_000_000",
+        "paths" | "compare.paths" | "table.paths" => "an integer from 2 to 10^15, e.g. 1000000 or 1_000_000",
         "seed" => "an integer >= 0",
         "detector.cos_theta_bins" | "detector.phi_bins" => "an integer from 1 to 4096",
         _ => "an integer >= 1",
@@ -99,7 +165,8 @@ pub(super) fn required(key: &str) -> Option<String> {
     let kinds = "\"conductor\", \"dielectric\", \"diffuse\" or \"hammon\"";
     Some(match key {
         "paths" => "photons per case, from 2 to 10^15".into(),
-        "table" => "the table config's facet, \"conductor\", \"dielectric\" or \"hammon\"".into(),
+        "table" => "a table with the grid of a `smithwalk lut` config, at least `paths` (configs/lut-*.toml)".into(),
+        "table.paths" => "photons per cell, from 2 to 10^15".into(),
         "surface" => "a table with `alpha`, the roughness".into(),
         "material" => format!("a table with `kind` = {kinds}, or several `[[material]]` tables"),
         "incident" => "a table with `theta_deg` or `theta_rad`, the incident polar angles".into(),
