@@ -1,6 +1,7 @@
 //! The run directory: its format ([`schema`]), the tables a run writes ([`output`]) and reads
-//! back ([`rundir`]).
+//! back ([`rundir`]), and the seal of `compare`'s tables ([`compare_json`]).
 
+pub mod compare_json;
 pub mod output;
 pub mod rundir;
 pub mod schema;
