@@ -10,7 +10,7 @@ use crate::atomic::{lock_dir, prepare_dir};
 use crate::commands::options::{default_out, note_threads};
 use crate::commands::summary::{report, threads_text};
 use crate::engine::checkpoint::{self, Checkpointer};
-use crate::engine::resources::{check_resources, gigabytes, peak_memory};
+use crate::engine::resources::{check_disk, check_resources, gigabytes, peak_memory};
 use crate::engine::run::{Estimator, Shard};
 use crate::engine::shard::write_shard;
 use crate::engine::{RunOptions, Simulation};
@@ -58,7 +58,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     let lock = lock_dir(&out, true)?;
     let (sim, checkpoints) = walk(&args, &config, shard, &out, true)?;
     if shard != Shard::WHOLE {
-        let written = write_shard(&sim, &config, shard, &out)?;
+        let written = write_shard(&sim, &config, shard, &out).map_err(|e| checkpoints.stopped("the shard", &e))?;
         checkpoints.finish()?;
         println!(
             "shard {}/{} of {} cases in {:.2} s on {}: wrote {}",
@@ -71,7 +71,8 @@ pub fn run(args: RunArgs) -> Result<()> {
         );
         return Ok(());
     }
-    let written = crate::io::output::write_outputs(&sim, &config, &out)?;
+    let written =
+        crate::io::output::write_outputs(&sim, &config, &out).map_err(|e| checkpoints.stopped("the tables", &e))?;
     checkpoints.finish()?;
     // The run is complete: its comparison reads it like any reader, under a shared lock.
     drop(lock);
@@ -113,6 +114,11 @@ fn walk(
     dir: &Path,
     show_progress: bool,
 ) -> Result<(Simulation, Checkpointer)> {
+    let (disk, free) = check_disk(config, dir)?;
+    if show_progress {
+        let free = free.map_or(String::new(), |f| format!(", where {} are free", gigabytes(f)));
+        println!("disk: up to {} written into {}{free}", gigabytes(disk.bytes()), dir.display());
+    }
     let states = if args.resume { checkpoint::load(dir, config, shard)? } else { None };
     let mut checkpoints = Checkpointer::new(dir, Duration::from_secs_f64(args.checkpoint_seconds), config, shard)?;
     let options = RunOptions {

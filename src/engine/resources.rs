@@ -1,6 +1,9 @@
-//! What a run needs before it starts: its thread count and its peak memory, estimated from the
-//! config alone and held against the memory the process may use (docs/reliability.md,
-//! "Memory"), so that a config that cannot finish is refused in one line before any work.
+//! What a run needs before it starts: its thread count, its peak memory and the bytes it writes,
+//! estimated from the config alone and held against the memory the process may use and the
+//! room on the output volume (docs/reliability.md, "Memory" and "Disk"), so that a config that
+//! cannot finish is refused in one line before any work.
+
+use std::path::Path;
 
 use anyhow::{Result, bail};
 
@@ -22,6 +25,17 @@ const CSV_ROW_BYTES: u64 = 160;
 
 /// Bytes of the process before any detector: the binary, the allocator, the threads' stacks.
 const BASELINE_BYTES: u64 = 16 << 20;
+
+/// Bytes per row of `lobes.csv` assumed by the disk estimate: the rows of the quickstart at
+/// 1.5 million photons take 226 bytes on average and 256 at most (a lit bin's numbers carry
+/// 17 significant digits).
+const DISK_ROW_BYTES: u64 = 256;
+
+/// Bytes per case of `run.json` assumed by the disk estimate (a case takes about 1 kB).
+const RECORD_BYTES_PER_CASE: u64 = 4 << 10;
+
+/// Bytes per order slot of a case in `summary.csv`: a row per hemisphere and channel.
+const SUMMARY_BYTES_PER_SLOT: u64 = 6 * DISK_ROW_BYTES;
 
 /// A run's estimated peak memory, by part.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,6 +81,86 @@ impl MemoryEstimate {
             .saturating_add(self.table_bytes)
             .saturating_add(BASELINE_BYTES)
     }
+}
+
+/// The most bytes a run writes into its output directory at once, by part: its tables, and its
+/// checkpoint twice (a new one is written beside the last before it replaces it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiskEstimate {
+    /// `lobes.csv`, `summary.csv` and `run.json`, with every order slot reached in both
+    /// hemispheres.
+    pub table_bytes: u64,
+    /// One `checkpoint.bin` (or `shard.bin`) with every order slot reached.
+    pub checkpoint_bytes: u64,
+}
+
+impl DiskEstimate {
+    /// The estimate for `config`: an upper bound, as [`MemoryEstimate::of`] (slots up to
+    /// `detector.max_order`, [`DEFAULT_MAX_ORDER`] when the config leaves it out).
+    pub fn of(config: &Config) -> Self {
+        let d = &config.detector;
+        let slots = u64::from(d.max_order.unwrap_or(DEFAULT_MAX_ORDER)) + 1;
+        let bins = (d.cos_theta_bins * d.phi_bins) as u64;
+        let (per_bin, channels) = if config.is_rgb() {
+            (Detector::<3>::saved_bytes_per_bin(), 3)
+        } else {
+            (Detector::<1>::saved_bytes_per_bin(), 1)
+        };
+        // Per case: both hemispheres of every slot.
+        let slot_bins = slots.saturating_mul(2 * bins);
+        let cases = config.cases();
+        let rows = cases.saturating_mul(slot_bins).saturating_mul(channels);
+        let records = RECORD_BYTES_PER_CASE.saturating_add(slots.saturating_mul(SUMMARY_BYTES_PER_SLOT));
+        Self {
+            table_bytes: rows.saturating_mul(DISK_ROW_BYTES).saturating_add(cases.saturating_mul(records)),
+            checkpoint_bytes: cases.saturating_mul(slot_bins).saturating_mul(per_bin),
+        }
+    }
+
+    /// The estimate in bytes: the tables and two checkpoints.
+    pub fn bytes(&self) -> u64 {
+        self.table_bytes.saturating_add(self.checkpoint_bytes.saturating_mul(2))
+    }
+}
+
+/// Checks, before any work, that the volume of `dir` (which exists) has room for what a run of
+/// `config` writes there ([`DiskEstimate`]). Returns the estimate and the bytes free (`None`
+/// if the volume cannot tell), for the run to print.
+pub fn check_disk(config: &Config, dir: &Path) -> Result<(DiskEstimate, Option<u64>)> {
+    let estimate = DiskEstimate::of(config);
+    let free = free_space(dir);
+    if let Some(free) = free {
+        check_room(config, &estimate, free, dir)?;
+    }
+    Ok((estimate, free))
+}
+
+/// Refuses a run whose estimated writes exceed the `free` bytes of the volume of `dir`, in one
+/// line naming the fields that size them.
+fn check_room(config: &Config, estimate: &DiskEstimate, free: u64, dir: &Path) -> Result<()> {
+    if estimate.bytes() <= free {
+        return Ok(());
+    }
+    let d = &config.detector;
+    bail!(
+        "the run writes up to {} into {} but its volume has {} free: lobes.csv and two checkpoints of {} cases x \
+         {} x {} bins (detector.cos_theta_bins x detector.phi_bins) x {} order slots (detector.max_order = {}); \
+         free space, choose another --out, lower the bins or detector.max_order, or sweep fewer cases",
+        gigabytes(estimate.bytes()),
+        dir.display(),
+        gigabytes(free),
+        config.cases(),
+        d.cos_theta_bins,
+        d.phi_bins,
+        u64::from(d.max_order.unwrap_or(DEFAULT_MAX_ORDER)) + 1,
+        d.max_order.unwrap_or(DEFAULT_MAX_ORDER)
+    )
+}
+
+/// The bytes an unprivileged process may still write on the volume of `dir`, if it can tell.
+fn free_space(dir: &Path) -> Option<u64> {
+    let stat = rustix::fs::statvfs(dir).ok()?;
+    Some(stat.f_bavail.saturating_mul(stat.f_frsize))
 }
 
 /// How much memory the process may use, and where that figure comes from.
@@ -238,6 +332,25 @@ fn slurm_memory() -> Option<u64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 36 item 16: a run whose estimated writes exceed the room on the volume is refused
+    /// in one line naming the sizes and the fields to change; one that fits is not.
+    #[test]
+    fn a_run_without_room_on_its_volume_is_refused() {
+        let config = Config::parse(
+            "paths = 1000\n[surface]\nalpha = [0.3, 0.6]\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 30\n\
+             [detector]\ncos_theta_bins = 8\nphi_bins = 16\nmax_order = 3\n",
+        )
+        .unwrap();
+        let estimate = DiskEstimate::of(&config);
+        let dir = Path::new("/scratch/out");
+        assert!(check_room(&config, &estimate, estimate.bytes(), dir).is_ok());
+        let e = format!("{:#}", check_room(&config, &estimate, estimate.bytes() - 1, dir).unwrap_err());
+        assert!(!e.contains('\n'), "{e}");
+        for words in ["into /scratch/out but its volume has", "2 cases x 8 x 16 bins", "4 order slots", "--out"] {
+            assert!(e.contains(words), "{words:?} not in: {e}");
+        }
+    }
 
     #[test]
     fn sizes_read_with_their_units() {

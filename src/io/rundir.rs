@@ -5,8 +5,9 @@
 //! A run directory is validated before any of it is used ([`RunDir::open`]): the tables must be
 //! the ones `run.json` records (SHA-256 digests: nothing changed them, and they belong to the
 //! same run), complete (every case, order slot, hemisphere, channel and bin exactly once) and
-//! finite, with non-negative energies. `models.csv`, when a command reads it, must hold the rows
-//! of `lobes.csv` in the same order (the same key columns), with finite non-negative values.
+//! finite, with non-negative energies. `models.csv` and `compare.csv`, when a command reads them,
+//! must be the ones `compare.json` records for this run (`io::compare_json`), and `models.csv`
+//! must hold the rows of `lobes.csv` in the same order (the same key columns), with finite non-negative values.
 //! Otherwise the reader gets one error and writes nothing.
 
 use std::collections::HashMap;
@@ -18,6 +19,7 @@ use serde::Deserialize;
 use crate::atomic::{DirLock, lock_dir};
 use crate::engine::detector::Grid;
 use crate::input;
+use crate::io::compare_json::{self, RunIdentity, Settings};
 use crate::io::output::{TABLES, self_digest, sha256_hex};
 use crate::io::schema::{self, Column};
 use crate::setup::cases::Case;
@@ -64,6 +66,9 @@ struct RunJson {
     #[serde(default)]
     format_version: Option<u32>,
     config: Config,
+    /// Absent in run directories written before runs had an identifier.
+    #[serde(default)]
+    run_id: String,
     #[serde(default)]
     files: Option<HashMap<String, FileRecord>>,
     cases: Vec<CaseJson>,
@@ -127,8 +132,8 @@ impl Shape<'_> {
     }
 }
 
-/// `run.json` of `dir`, checked against the tables beside it.
-fn read_run_json(dir: &Path) -> Result<RunJson> {
+/// `run.json` of `dir`, checked against the tables beside it, and the run's identity.
+fn read_run_json(dir: &Path) -> Result<(RunJson, RunIdentity)> {
     let path = dir.join(schema::RUN_JSON);
     let text = input::read_to_string(&path, input::MAX_RUN_JSON_BYTES)
         .with_context(|| format!("cannot read {}", path.display()))?;
@@ -172,7 +177,9 @@ fn read_run_json(dir: &Path) -> Result<RunJson> {
             );
         }
     }
-    Ok(run)
+    let tables = TABLES.iter().map(|t| (t.to_string(), files[*t].sha256.clone())).collect();
+    let identity = RunIdentity { run_id: run.run_id.clone(), tables };
+    Ok((run, identity))
 }
 
 /// The value of column `column` of a row as a number that must be finite (and >= 0 if
@@ -353,14 +360,24 @@ fn model_columns(headers: &csv::StringRecord) -> Vec<(String, usize, usize)> {
         .collect()
 }
 
-/// Reads `models.csv` into lobes per model, once it is checked to hold the rows of `lobes.csv`
-/// in their order (by their key columns), each model's cells both empty (the model gives no
+/// Reads `models.csv` into lobes per model, once it is checked to have the columns of the
+/// models `recorded` (in their order) and to hold the rows of `lobes.csv` in their order (by their key columns), each model's cells both empty (the model gives no
 /// such lobe) or both finite and non-negative. A model's BSDF is its energy over the bin's
 /// projected solid angle, as in `lobes.csv`.
-fn read_models(path: &Path, shape: &Shape) -> Result<HashMap<String, Lobes>> {
+fn read_models(path: &Path, shape: &Shape, recorded: &[String]) -> Result<HashMap<String, Lobes>> {
     let table = Table::read(path, shape.table_limit)?;
     let keys = BinKeys::of(&table)?;
     let models = model_columns(&table.headers);
+    let names: Vec<&str> = models.iter().map(|(name, ..)| name.as_str()).collect();
+    if names != recorded {
+        bail!(
+            "{}: its models ({}) are not the ones {} records ({}); rerun `smithwalk compare`",
+            path.display(),
+            names.join(", "),
+            schema::COMPARE_JSON.file,
+            recorded.join(", ")
+        );
+    }
     let (offsets, _) = shape.rows(&table, |hemispheres, slots| lobe_rows(shape, hemispheres, slots))?;
     let mut out: HashMap<String, Lobes> = HashMap::new();
     for (line, r) in table.records.iter().enumerate() {
@@ -499,6 +516,8 @@ pub struct RunDir {
     /// The most bytes read of one of its tables or of a table in its bins (`models.csv`,
     /// `compare.csv`, `--external`): [`input::bins_table_limit`] of its `lobes.csv`.
     pub table_limit: u64,
+    /// Which run this is: what `compare.json` records of the run it belongs to.
+    pub identity: RunIdentity,
     /// A shared lock: no run writes into the directory while it is read.
     _lock: DirLock,
 }
@@ -509,7 +528,7 @@ impl RunDir {
     /// non-negative energies (see the module doc). Otherwise one error names what is wrong.
     pub fn open(path: &Path) -> Result<Self> {
         let lock = lock_dir(path, false)?;
-        let run = read_run_json(path)?;
+        let (run, identity) = read_run_json(path)?;
         let config = run.config;
         let cases = crate::setup::cases::expand(&config)?;
         if run.cases.len() != cases.len() {
@@ -535,7 +554,7 @@ impl RunDir {
         }
         let lobes_bytes = run.files.as_ref().and_then(|f| f.get(TABLES[0])).map_or(0, |f| f.bytes);
         let table_limit = input::bins_table_limit(lobes_bytes);
-        let run = Self { path: path.to_path_buf(), config, cases, grid, slots, table_limit, _lock: lock };
+        let run = Self { path: path.to_path_buf(), config, cases, grid, slots, table_limit, identity, _lock: lock };
         let shape = run.shape();
         read_lobes(&path.join(TABLES[0]), &shape)?;
         check_summary(&path.join(TABLES[1]), &shape)?;
@@ -547,16 +566,21 @@ impl RunDir {
         read_lobes(&self.path.join(schema::LOBES.file), &self.shape())
     }
 
+    /// The settings of the comparison beside the run, once `models.csv`, `compare.csv` and
+    /// `compare.json` are checked to be one sealed set that belongs to this run
+    /// ([`compare_json::verify`]); `None` if `compare` has not run.
+    pub fn comparison(&self) -> Result<Option<Settings>> {
+        compare_json::verify(&self.path, &self.identity)
+    }
+
     /// The model lobes of `models.csv` per model name (its columns `<name>` with a
-    /// `<name>_stderr`; a model without any lobe is absent), once the file is checked: the rows
-    /// of `lobes.csv` in its order, each model's two cells both empty or both finite numbers
-    /// >= 0. Empty if `compare` has not run.
+    /// `<name>_stderr`; a model without any lobe is absent), once the comparison is checked
+    /// ([`RunDir::comparison`]) and the file too: its models the ones `compare.json` records,
+    /// the rows of `lobes.csv` in its order, each model's two cells both empty or both finite
+    /// numbers >= 0. Empty if `compare` has not run.
     pub fn models(&self) -> Result<HashMap<String, Lobes>> {
-        let path = self.path.join(schema::MODELS.file);
-        if !path.exists() {
-            return Ok(HashMap::new());
-        }
-        read_models(&path, &self.shape())
+        let Some(settings) = self.comparison()? else { return Ok(HashMap::new()) };
+        read_models(&self.path.join(schema::MODELS.file), &self.shape(), &settings.models)
     }
 
     fn shape(&self) -> Shape<'_> {

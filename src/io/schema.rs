@@ -237,9 +237,43 @@ pub const RUN_JSON: &str = "run.json";
 /// The files a finished run writes, as one atomic set; `run.json` records the tables' digests.
 pub const RUN_FILES: [&str; 3] = [LOBES.file, SUMMARY.file, RUN_JSON];
 
-/// The files `compare` derives from a run, as one atomic set; a new run into the directory
-/// removes them.
-pub const COMPARE_FILES: [&str; 2] = [MODELS.file, COMPARE.file];
+/// A JSON record of the run directory: its file name and its top-level fields.
+#[derive(Clone, Copy, Debug)]
+pub struct RecordSchema {
+    /// The file name in the run directory.
+    pub file: &'static str,
+    /// Every top-level field, in the order written (units are empty).
+    pub fields: &'static [Column],
+}
+
+/// `compare.json`: the seal of `compare`'s tables. It records their digests, the run they
+/// belong to and the comparison's settings; `compare` writes it last, and readers refuse
+/// tables it does not describe (`io::compare_json`).
+pub const COMPARE_JSON: RecordSchema = RecordSchema {
+    file: "compare.json",
+    fields: &[
+        column("format_version", "", "the run directory's format, as in run.json"),
+        column("smithwalk_version", "", "the version of smithwalk that compared"),
+        column("run_id", "", "the run_id of the run.json compared"),
+        column(
+            "run_tables",
+            "",
+            "SHA-256 of the run's lobes.csv and summary.csv: the comparison belongs to a run with these tables only",
+        ),
+        column(
+            "settings",
+            "",
+            "models (in the order compared), paths per case of the Monte Carlo models, seed, family_level, \
+             external and albedo_table (the paths given, or null)",
+        ),
+        column("files", "", "models.csv and compare.csv: their bytes and SHA-256"),
+        column("self_sha256", "", "SHA-256 of this file's text with these 64 digits written as zeros"),
+    ],
+};
+
+/// The files `compare` derives from a run, as one atomic set, `compare.json` last; a new run
+/// into the directory removes them.
+pub const COMPARE_FILES: [&str; 3] = [MODELS.file, COMPARE.file, COMPARE_JSON.file];
 
 impl TableSchema {
     /// The header of this table: its columns, without the channel column unless `rgb`, and in

@@ -1,4 +1,4 @@
-//! `smithwalk compare` and the models it judges: verdicts end to end, `models.csv`, the
+//! `smithwalk compare` and the models it judges: verdicts end to end, `models.csv`, its seal, the
 //! energy-compensation models and the albedo tables they read. One test binary (each file a
 //! module) so that the crate is linked once.
 
@@ -10,3 +10,4 @@ mod compare;
 mod compare_verdicts;
 mod compensation;
 mod models_table;
+mod sealed;

@@ -106,6 +106,7 @@ fn the_report_takes_family_level_and_rejections_from_compare_csv_when_present() 
         out.push_str(&format!("{},0.5,{line}\n", i == 3));
     }
     std::fs::write(&path, out).unwrap();
+    crate::common::reseal_comparison(dir.path());
     plot(dir.path(), &PlotOptions::default()).unwrap();
     let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
     let row = format!("<tr><td>single</td><td>12</td><td>0.5</td><td>{level:.2e}</td><td>1</td>");

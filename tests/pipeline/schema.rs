@@ -1,7 +1,7 @@
 //! The run directory's format is the one `io::schema` declares: every file a run and `compare`
 //! write is declared there, each table's header is exactly the schema's (in order), `run.json`
 //! carries the format version, a newer format is refused, and docs/run-directory.md describes
-//! every column the schema declares.
+//! every file, every column and every field of `compare.json` the schema declares.
 
 use std::path::Path;
 
@@ -50,6 +50,13 @@ fn every_file_and_column_written_is_the_one_the_schema_declares() {
         let json: serde_json::Value =
             serde_json::from_slice(&std::fs::read(dir.join(schema::RUN_JSON)).unwrap()).unwrap();
         assert_eq!(json["format_version"], schema::FORMAT_VERSION, "{name}: run.json's format_version");
+        let record: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.join(schema::COMPARE_JSON.file)).unwrap()).unwrap();
+        let mut written: Vec<&str> = record.as_object().unwrap().keys().map(String::as_str).collect();
+        let mut declared: Vec<&str> = schema::COMPARE_JSON.fields.iter().map(|f| f.name).collect();
+        written.sort();
+        declared.sort();
+        assert_eq!(written, declared, "{name}: the fields of compare.json");
     }
 }
 
@@ -99,5 +106,15 @@ fn docs_describe_every_column_of_every_table() {
             let row = format!("| `{}` | {} | {} |", column.name, column.unit, column.meaning);
             assert!(section.contains(&row), "{}: docs/run-directory.md lacks the row\n{row}", table.file);
         }
+    }
+    // Every file in the table of files, and every field of compare.json in its section.
+    for file in schema::RUN_FILES.iter().chain(&schema::COMPARE_FILES) {
+        assert!(doc.contains(&format!("\n| `{file}` | ")), "docs/run-directory.md does not list {file}");
+    }
+    let heading = format!("## `{}`", schema::COMPARE_JSON.file);
+    let section = &doc[doc.find(&heading).unwrap_or_else(|| panic!("docs/run-directory.md has no {heading}"))..];
+    for field in schema::COMPARE_JSON.fields {
+        let row = format!("| `{}` |  | {} |", field.name, field.meaning);
+        assert!(section.contains(&row), "compare.json: docs/run-directory.md lacks the row\n{row}");
     }
 }

@@ -269,6 +269,23 @@ def test_compare_matches_the_command_line(cli, tmp_path):
         result.compare(["wang"])
 
 
+def test_load_refuses_a_comparison_that_is_not_sealed_with_the_run(tmp_path):
+    # Issue 36 item 5: compare.json seals models.csv and compare.csv with the run's tables.
+    result = smithwalk.run(MONO, paths=5_000)
+    result.compare(["single"], paths=5_000, threads=2)
+    run = tmp_path / "run"
+    result.save(run)
+    assert smithwalk.load(run).comparison is not None
+    models = run / "models.csv"
+    header, rows = models.read_text().split("\n", 1)
+    models.write_text(header.replace("single", "hammon-fit") + "\n" + rows)
+    with pytest.raises(ValueError, match="is not the models.csv that .* records"):
+        smithwalk.load(run)
+    (run / "compare.json").unlink()
+    with pytest.raises(ValueError, match="without compare.json"):
+        smithwalk.load(run)
+
+
 def test_a_compare_table_in_the_config_runs_the_comparison():
     result = smithwalk.run(RGB + '\n[compare]\nmodels = ["single"]\n', paths=5_000)
     assert result.comparison.models == ("single",)

@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Result, bail};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::{ProgressBar, ProgressFinish, ProgressStyle};
 
 use self::lobe::{channel_index, folded_slot, hemisphere_name, is_tested};
 use self::predict::{
@@ -48,6 +48,7 @@ use crate::analysis::models::{
     MAX_BIN_EVALUATIONS, MAX_EXIT_BIN_EVALUATIONS, hammon_fit_unavailable, single_scattering_unavailable,
 };
 use crate::atomic::write_atomically;
+use crate::io::compare_json::{self, Settings};
 use crate::io::rundir::{BinValue, LobeId, RunDir};
 use crate::io::schema;
 use crate::setup::config::{MAX_PATHS, Model};
@@ -129,16 +130,33 @@ fn model_progress(model: Model, terminal: bool) -> ProgressBar {
     bar
 }
 
+/// A spinner on a terminal naming a step of `compare` outside the models (reading and checking a
+/// run of many cases takes seconds, so does writing its tables), hidden otherwise.
+fn step_progress(what: String, terminal: bool) -> ProgressBar {
+    if !terminal {
+        return ProgressBar::hidden();
+    }
+    // Cleared also when an error ends the step.
+    let bar = ProgressBar::new_spinner().with_finish(ProgressFinish::AndClear);
+    bar.set_style(ProgressStyle::with_template("{spinner} {msg} {elapsed_precise}").expect("static template"));
+    bar.set_message(what);
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
+}
+
 /// [`compare_with`] at the default family level: the report to print.
 pub fn compare(run_dir: &Path, models: &[Model], paths: Option<u64>, threads: Option<usize>) -> Result<String> {
     compare_with(run_dir, &CompareOptions::new(models.to_vec(), paths, threads)).map(|outcome| outcome.report)
 }
 
-/// Runs the comparison of `run_dir` with the models of `options`, writes `models.csv` and
-/// `compare.csv` into it and returns the report and the verdicts. Progress goes to stderr: on a
-/// terminal the model being evaluated, otherwise one line per model when it finishes.
+/// Runs the comparison of `run_dir` with the models of `options`, writes `models.csv`,
+/// `compare.csv` and their seal `compare.json` into it, as one set, and returns the report and
+/// the verdicts. Progress goes to stderr: on a terminal every step (reading the run, each model, writing the tables), otherwise one line
+/// per model when it finishes.
 pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome> {
     options.validate()?;
+    let terminal = std::io::stderr().is_terminal();
+    let reading = step_progress(format!("compare: reading {}", run_dir.display()), terminal);
     let run = RunDir::open(run_dir)?;
     if let Some(reason) = options.models.iter().find_map(|m| m.refuses_threshold(run.config.energy.threshold)) {
         bail!("`--models`: {reason}");
@@ -158,6 +176,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
     }
     let measured = run.measured()?;
     let summary = run.summary()?;
+    reading.finish_and_clear();
     let measured_photons = run.config.paths;
     let mut config = run.config.clone();
     if let Some(p) = options.paths {
@@ -176,7 +195,6 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
             })
             .map_or(Value::default(), |r| Value { energy: r.albedo, stderr: r.albedo_stderr })
     };
-    let terminal = std::io::stderr().is_terminal();
     let mut predicted: Vec<(Model, Vec<ModelLobe>)> = Vec::new();
     let mut comparisons = Vec::new();
     let mut notes: Vec<(Model, String)> = Vec::new();
@@ -271,10 +289,33 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
             cpu_seconds() - cpu_start
         );
     }
+    let writing = step_progress(
+        format!("compare: writing {}, {} and {}", schema::MODELS.file, schema::COMPARE.file, schema::COMPARE_JSON.file),
+        terminal,
+    );
     let verdicts = verdicts(&models, &comparisons, &skipped, options.family_level);
     let compare_csv = compare_table(&comparisons, &run, &verdicts, options.family_level, rgb, folded)?;
     let models_csv = models_table(&run, &predicted, rgb, folded)?;
-    write_atomically(run_dir, &[(schema::MODELS.file, models_csv), (schema::COMPARE.file, compare_csv)])?;
+    let settings = Settings {
+        models: models.iter().map(|m| m.name().to_string()).collect(),
+        paths: config.paths,
+        seed: config.seed,
+        family_level: options.family_level,
+        external: options.external.as_ref().map(|p| p.display().to_string()),
+        albedo_table: options.albedo_table.as_ref().map(|p| p.display().to_string()),
+    };
+    let record = compare_json::text(
+        &run.identity,
+        &settings,
+        &[(schema::MODELS.file, &models_csv), (schema::COMPARE.file, &compare_csv)],
+    )?;
+    // One set: compare.json last, so that a compare killed between the renames leaves tables
+    // that the previous record does not describe, which readers refuse.
+    write_atomically(
+        run_dir,
+        &[(schema::MODELS.file, models_csv), (schema::COMPARE.file, compare_csv), (schema::COMPARE_JSON.file, record)],
+    )?;
+    writing.finish_and_clear();
     let report = report(&comparisons, &verdicts, &notes, options.family_level, rgb, folded, options.default_models);
     Ok(Outcome { report, verdicts })
 }

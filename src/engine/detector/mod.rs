@@ -132,6 +132,13 @@ impl<const C: usize> Detector<C> {
     pub fn bytes_per_bin() -> u64 {
         (std::mem::size_of::<Tally<C>>() + std::mem::size_of::<ChunkBin<C>>() + std::mem::size_of::<u32>()) as u64
     }
+    /// Bytes per bin of one hemisphere of one order slot in a checkpoint or shard file, at
+    /// most: postcard writes each integer of the bin's tally as a varint of at most 19 bytes
+    /// for 16 (`i128`) and 10 for 8 (`u64`), so within 5/4 of the tally's size in memory.
+    pub fn saved_bytes_per_bin() -> u64 {
+        (std::mem::size_of::<Tally<C>>() as u64 * 5).div_ceil(4)
+    }
+
     /// A detector for light arriving from `wi` (towards the light).
     pub fn new(grid: Grid, wi: DVec3, max_order: Option<u32>) -> Self {
         let horizontal = wi.x.hypot(wi.y);

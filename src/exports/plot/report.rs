@@ -77,12 +77,14 @@ struct Comparison {
     rejected: Option<bool>,
 }
 
-fn read_comparisons(run_dir: &Path, limit: u64) -> Result<Option<Vec<Comparison>>> {
-    let path = run_dir.join(schema::COMPARE.file);
-    if !path.exists() {
+/// The rows of `compare.csv`, once the comparison is checked to be sealed and this run's
+/// ([`RunDir::comparison`]); `None` if `compare` has not run.
+fn read_comparisons(run: &RunDir) -> Result<Option<Vec<Comparison>>> {
+    if run.comparison()?.is_none() {
         return Ok(None);
     }
-    let table = Table::read(&path, limit)?;
+    let path = run.path.join(schema::COMPARE.file);
+    let table = Table::read(&path, run.table_limit)?;
     let column = |c| table.column(c);
     let optional = |c| table.optional(c);
     let (case, model, order, hemisphere) =
@@ -246,7 +248,7 @@ pub(super) fn page(
             String::new()
         }
     );
-    if let Some(rows) = read_comparisons(run_dir, run.table_limit)? {
+    if let Some(rows) = read_comparisons(run)? {
         comparison_tables(&mut html, run, &rows);
     }
     let mut number = 0;

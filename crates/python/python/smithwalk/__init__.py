@@ -425,7 +425,7 @@ def load(path):
     ----------
     path : str or os.PathLike
         The directory with ``run.json``, ``lobes.csv`` and ``summary.csv`` (and, after a
-        comparison, ``models.csv`` and ``compare.csv``).
+        comparison, ``models.csv``, ``compare.csv`` and their seal ``compare.json``).
 
     Returns
     -------
@@ -435,7 +435,8 @@ def load(path):
     Raises
     ------
     ValueError
-        When a file is missing or not a table of a run.
+        When a file is missing or not a table of a run, or when ``models.csv`` and
+        ``compare.csv`` are not the ones ``compare.json`` records for this run.
     """
     path = Path(path)
     config = json.loads(_native.read_config(path))
@@ -447,9 +448,10 @@ def load(path):
     result = RunResult(
         info=info, lobes=lobes, summary_csv=(path / "summary.csv").read_bytes(), path=path
     )
-    if all((path / name).exists() for name in _COMPARE_FILES):
-        files = {name: (path / name).read_bytes() for name in _COMPARE_FILES}
+    # Any of the comparison's files: read_models refuses a set that compare.json does not seal.
+    if any((path / name).exists() for name in _COMPARE_FILES):
         lobes = _native.read_models(path)
+        files = {name: (path / name).read_bytes() for name in _COMPARE_FILES}
         models = _model_names(files["models.csv"])
         result.comparison = Comparison(models, files, lobes, report="")
     return result
