@@ -103,6 +103,14 @@ def _columns(value, n=None):
     return np.ascontiguousarray(a if n is None else np.broadcast_to(a, (n, a.shape[1])))
 
 
+def _unit(value):
+    """Mitsuba's float32 directions as float64 unit vectors (n, 3): the walk assumes unit
+    length, and float32 rounding alone would break reciprocity near total internal reflection."""
+    a = _columns(value)
+    length = np.linalg.norm(a, axis=1)[:, None]
+    return a / np.where(length > 0, length, 1.0)
+
+
 def _vector(cls, a):
     """numpy (n, 3) as a Mitsuba vector or colour of the variant (one lane when scalar)."""
     if dr.is_jit_v(cls):
@@ -170,7 +178,7 @@ def register():
             return "radiance" if ctx.mode == mi.TransportMode.Radiance else "importance"
 
         def sample(self, ctx, si, sample1, sample2, active=True):
-            wi = _columns(si.wi)
+            wi = _unit(si.wi)
             n = len(wi)
             u = np.concatenate([_columns(sample1, n), _columns(sample2, n)], axis=1)
             on = _columns(active, n)[:, 0] > 0
@@ -196,14 +204,14 @@ def register():
             return self.eval_pdf(ctx, si, wo, active)[0]
 
         def pdf(self, ctx, si, wo, active=True):
-            wi, wo = _columns(si.wi), _columns(wo)
+            wi, wo = _unit(si.wi), _unit(wo)
             n = len(wi)
             on = _columns(active, n)[:, 0] > 0
             pdf = _bsdf.pdf(wi, wo, **self.surface(si, active, n))
             return _lanes(mi.Float, np.where(on, pdf, 0.0).astype(np.float32))
 
         def eval_pdf(self, ctx, si, wo, active=True):
-            wi, wo = _columns(si.wi), _columns(wo)
+            wi, wo = _unit(si.wi), _unit(wo)
             n = len(wi)
             on = _columns(active, n)[:, 0] > 0
             surface = self.surface(si, active, n)
@@ -214,6 +222,9 @@ def register():
 
         def traverse(self, callback):
             pass
+
+        def to_string(self):
+            return f"{type(self).__name__}[ndf={self.ndf}, orders={self.orders}, seed={self.seed}]"
 
         def parameters_changed(self, keys):
             pass
