@@ -513,8 +513,36 @@ def test_non_rgb_variants_and_bad_parameters_are_refused_in_one_line():
         ({"orders": "two"}, ["orders", "two"]),
         ({"alpha": 0.3, "alpha_u": 0.2, "alpha_v": 0.2}, ["alpha", "alpha_u"]),
         ({"material": "Au", "eta": 0.2}, ["material", "Au", "eta"]),
+        ({"k": 3.0}, ["k", "eta"]),
+        ({"alpha": 0.0}, ["alpha", "0.0", "> 0"]),
+        ({"alpha_u": 0.3}, ["alpha_u", "alpha_v"]),
     ]:
         with pytest.raises(Exception) as error:
             mi.load_dict(dict({"type": "smithwalk_conductor"}, **props))
         for word in words:
             assert word in str(error.value), (props, str(error.value))
+
+
+def test_textured_roughness_is_read_per_lane():
+    # alpha as a checkerboard texture of 0.2 and 0.9: each lane's eval and sample equal, bit
+    # for bit, those of the BSDF with that lane's constant alpha (same streams).
+    variant("llvm_ad_rgb")
+    n = 64
+    rng = np.random.default_rng(15)
+    base = {"type": "smithwalk_conductor", "distribution": "ggx", "material": "Cu"}
+    checker = {"type": "checkerboard", "color0": 0.2, "color1": 0.9}
+    textured = plugin(dict(base, alpha=checker))
+    uv = rng.uniform(size=(n, 2)).astype(np.float32)
+    wi, wo, u = towards(40.0, 10.0, n), towards(60.0, 200.0, n), rng.uniform(size=(n, 3))
+    si = interaction(wi)
+    si.uv = mi.Point2f(uv[:, 0], uv[:, 1])
+    ctx = context("radiance")
+    f = np.array(textured.eval(ctx, si, mi.Vector3f(*(wo[:, j].astype(np.float32) for j in range(3))))).T
+    weight = np.array(textured.sample(ctx, si, mi.Float(u[:, 0]), mi.Point2f(u[:, 1], u[:, 2]))[1]).T
+    alpha = np.array(mi.load_dict(checker).eval_1(si))
+    assert set(np.unique(alpha)) == {np.float32(0.2), np.float32(0.9)}
+    for value in (0.2, 0.9):
+        lanes = alpha == np.float32(value)
+        constant = plugin(dict(base, alpha=value))
+        assert np.array_equal(plugin_eval(constant, wi, wo)[lanes], f[lanes])
+        assert np.array_equal(plugin_sample(constant, wi, u)[1][lanes], weight[lanes])

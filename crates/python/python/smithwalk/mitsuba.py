@@ -72,17 +72,19 @@ def _distribution(props):
 
 def _roughness(props):
     """The textures of (alpha_u, alpha_v), as Mitsuba's rough BSDFs read them."""
-    if ("alpha" in props):
-        if ("alpha_u" in props) or ("alpha_v" in props):
-            raise ValueError("`alpha` with `alpha_u`/`alpha_v` is not allowed: give one or the other")
-        alpha = props.get_unbounded_texture("alpha", 0.1)
-        return alpha, alpha
-    if ("alpha_u" in props) or ("alpha_v" in props):
-        if not (("alpha_u" in props) and ("alpha_v" in props)):
-            raise ValueError("`alpha_u` without `alpha_v` (or the reverse) is not allowed: give both")
-        return props.get_unbounded_texture("alpha_u"), props.get_unbounded_texture("alpha_v")
-    alpha = props.get_unbounded_texture("alpha", 0.1)
-    return alpha, alpha
+    has_u, has_v = "alpha_u" in props, "alpha_v" in props
+    if "alpha" in props and (has_u or has_v):
+        raise ValueError("`alpha` with `alpha_u`/`alpha_v` is not allowed: give one or the other")
+    if has_u != has_v:
+        raise ValueError("`alpha_u` without `alpha_v` (or the reverse) is not allowed: give both")
+    names = ("alpha_u", "alpha_v") if has_u else ("alpha", "alpha")
+    textures = tuple(props.get_unbounded_texture(name, 0.1) for name in names)
+    for name, texture in zip(names, textures):
+        # A constant is checked now; a varying texture lane by lane, by smithwalk.bsdf.
+        value = float(np.asarray(texture.mean(), dtype=np.float64).reshape(-1)[0])
+        if not texture.is_spatially_varying() and not value > 0:
+            raise ValueError(f"`{name}` = {value} is not allowed: a number > 0")
+    return textures if has_u else (textures[0], textures[0])
 
 
 def _seed(props):
@@ -160,17 +162,23 @@ def register():
             self.m_components = [flags]
             self.m_flags = flags
 
-        def surface(self, si, active, n):
-            """smithwalk.bsdf's surface keywords at the lanes of `si`."""
-            au = _columns(self.alpha_u.eval_1(si, active), n)[:, 0]
-            av = au if self.alpha_v is self.alpha_u else _columns(self.alpha_v.eval_1(si, active), n)[:, 0]
-            keywords = dict(material=self.material, ndf=self.ndf, orders=self.orders)
-            # A texture may return 0 or garbage on inactive lanes; keep them valid.
-            keywords.update(alpha_u=np.where(au > 0, au, 1.0), alpha_v=np.where(av > 0, av, 1.0))
-            keywords.update(self.material_keywords(si, active, n))
+        def surface(self, si, active, on):
+            """smithwalk.bsdf's surface keywords at the lanes of `si`. Lanes that are not
+            active (`on` False) get valid placeholders, as textures may return anything
+            there; active lanes pass as they are, so smithwalk.bsdf refuses bad values."""
+            n = len(on)
+
+            def lanes(texture, placeholder):
+                values = _columns(texture.eval_1(si, active), n)[:, 0]
+                return np.where(on, values, placeholder)
+
+            alpha_u = lanes(self.alpha_u, 1.0)
+            alpha_v = alpha_u if self.alpha_v is self.alpha_u else lanes(self.alpha_v, 1.0)
+            keywords = dict(material=self.material, ndf=self.ndf, orders=self.orders, alpha_u=alpha_u, alpha_v=alpha_v)
+            keywords.update(self.material_keywords(si, active, on))
             return keywords
 
-        def material_keywords(self, si, active, n):
+        def material_keywords(self, si, active, on):
             return {}
 
         @staticmethod
@@ -182,7 +190,7 @@ def register():
             n = len(wi)
             u = np.concatenate([_columns(sample1, n), _columns(sample2, n)], axis=1)
             on = _columns(active, n)[:, 0] > 0
-            surface = self.surface(si, active, n)
+            surface = self.surface(si, active, on)
             wo, weight, _ = _bsdf.sample(wi, u=u, seed=self.seed, transport=self.transport(ctx), **surface)
             pdf = _bsdf.pdf(wi, wo, **surface)
             weight[~on] = 0.0
@@ -207,14 +215,14 @@ def register():
             wi, wo = _unit(si.wi), _unit(wo)
             n = len(wi)
             on = _columns(active, n)[:, 0] > 0
-            pdf = _bsdf.pdf(wi, wo, **self.surface(si, active, n))
+            pdf = _bsdf.pdf(wi, wo, **self.surface(si, active, on))
             return _lanes(mi.Float, np.where(on, pdf, 0.0).astype(np.float32))
 
         def eval_pdf(self, ctx, si, wo, active=True):
             wi, wo = _unit(si.wi), _unit(wo)
             n = len(wi)
             on = _columns(active, n)[:, 0] > 0
-            surface = self.surface(si, active, n)
+            surface = self.surface(si, active, on)
             value = _bsdf.eval(wi, wo, seed=self.seed, transport=self.transport(ctx), **surface)
             pdf = _bsdf.pdf(wi, wo, **surface)
             value[~on] = 0.0
@@ -235,10 +243,14 @@ def register():
         def __init__(self, props):
             SmithwalkBSDF.__init__(self, props)
             name = props.get("material", "none")
-            if ("eta" in props) or ("k" in props):
+            if "eta" in props or "k" in props:
                 if name != "none":
                     raise ValueError(f"`material` = {name!r} with `eta`/`k` is not allowed: give one or the other")
-                self.eta = props.get_unbounded_texture("eta", 0.0)
+                if "eta" not in props:
+                    # Mitsuba's default eta is 0 (with k, a complex index); the walk's exact
+                    # Fresnel needs eta > 0.
+                    raise ValueError("`k` without `eta` is not allowed: give `eta` (> 0) too")
+                self.eta = props.get_unbounded_texture("eta")
                 self.k = props.get_unbounded_texture("k", 1.0)
                 self.fresnel = "exact"
             elif name == "none":
@@ -250,14 +262,15 @@ def register():
                 self.k_rgb = np.asarray(table["k.value"], dtype=np.float64).reshape(-1)[:3]
                 self.fresnel = "table"
 
-        def material_keywords(self, si, active, n):
+        def material_keywords(self, si, active, on):
             if self.fresnel == "none":
                 return dict(fresnel="none")
             if self.fresnel == "table":
                 return dict(fresnel="exact", eta=self.eta_rgb, k=self.k_rgb)
-            eta = _columns(self.eta.eval(si, active), n)
-            k = _columns(self.k.eval(si, active), n)
-            return dict(fresnel="exact", eta=np.where(eta > 0, eta, 1.0), k=np.maximum(k, 0.0))
+            n, mask = len(on), on[:, None]
+            eta = np.where(mask, _columns(self.eta.eval(si, active), n), 1.0)
+            k = np.where(mask, _columns(self.k.eval(si, active), n), 0.0)
+            return dict(fresnel="exact", eta=eta, k=k)
 
     class Dielectric(SmithwalkBSDF):
         material = "dielectric"
@@ -271,8 +284,8 @@ def register():
                 raise ValueError(f"`int_ior`/`ext_ior` = {int_ior}/{ext_ior} is not allowed: numbers > 0")
             self.eta = int_ior / ext_ior
 
-        def material_keywords(self, si, active, n):
-            return dict(eta=np.full(n, self.eta))
+        def material_keywords(self, si, active, on):
+            return dict(eta=np.full(len(on), self.eta))
 
     class Diffuse(SmithwalkBSDF):
         material = "lambertian"
@@ -281,8 +294,9 @@ def register():
             SmithwalkBSDF.__init__(self, props)
             self.reflectance = props.get_texture("reflectance", 0.5)
 
-        def material_keywords(self, si, active, n):
-            return dict(albedo=np.clip(_columns(self.reflectance.eval(si, active), n), 0.0, 1.0))
+        def material_keywords(self, si, active, on):
+            albedo = _columns(self.reflectance.eval(si, active), len(on))
+            return dict(albedo=np.where(on[:, None], albedo, 0.0))
 
     mi.register_bsdf("smithwalk_conductor", lambda props: Conductor(props))
     mi.register_bsdf("smithwalk_dielectric", lambda props: Dielectric(props))
