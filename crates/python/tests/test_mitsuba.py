@@ -40,9 +40,10 @@ def variant(name):
     """Switches Mitsuba to `name` and registers the plugins for it."""
     if name not in mi.variants():
         _missing(f"mitsuba has no variant {name}")
-    mi.set_variant(name)
-    if name.startswith("llvm") and not dr.has_backend(dr.JitBackend.LLVM):
-        _missing("Dr.Jit found no usable libLLVM: apt-get install libllvm19, set DRJIT_LIBLLVM_PATH")
+    try:
+        mi.set_variant(name)
+    except ImportError as error:  # Dr.Jit found no libLLVM
+        _missing(f"{error} (apt-get install libllvm19; DRJIT_LIBLLVM_PATH)")
     import smithwalk.mitsuba
 
     smithwalk.mitsuba.register()
