@@ -123,16 +123,24 @@ def test_white_furnace_mirror_conductor_renders_one_and_mitsubas_roughconductor_
     assert mean_mi < 1.0 - 3 * se_mi, (mean_mi, se_mi)
 
 
-def test_white_furnace_lossless_dielectric_renders_one():
+@pytest.mark.parametrize(
+    "bsdf",
+    [
+        {"type": "smithwalk_dielectric", "distribution": "ggx", "alpha": 0.5, "int_ior": 1.5, "ext_ior": 1.0},
+        {"type": "smithwalk_diffuse", "distribution": "beckmann", "alpha": 0.5, "reflectance": 1.0},
+    ],
+    ids=["dielectric", "diffuse"],
+)
+def test_white_furnace_lossless_dielectric_and_white_diffuse_render_one(bsdf):
     # A dielectric sphere (int_ior 1.5, ext_ior 1, GGX alpha 0.5): reflection, refraction and
     # total internal reflection are lossless, so it renders 1 (the radiance inside is 1.5^2,
-    # carried by the eta^2 factors of the radiance transport). Same statistics as above:
-    # 616 independent pixels, 32 spp, 3 standard errors.
+    # carried by the eta^2 factors of the radiance transport). Lambertian facets of
+    # reflectance 1 are lossless too. Same statistics as above: 616 independent pixels,
+    # 32 spp, 3 standard errors.
     variant("llvm_ad_rgb")
-    bsdf = {"type": "smithwalk_dielectric", "distribution": "ggx", "alpha": 0.5, "int_ior": 1.5, "ext_ior": 1.0}
     image = render(bsdf, 32, 32, seed=2)
     mean, se = mean_and_se(image[inside_pixels(32)][:, 0])
-    print(f"dielectric: {mean:.4f} +- {se:.4f}")
+    print(f"{bsdf['type']}: {mean:.4f} +- {se:.4f}")
     assert abs(mean - 1.0) < 3 * se, (mean, se)
 
 
