@@ -186,8 +186,9 @@ def test_order_one_alone_renders_the_height_correlated_single_scattering_albedo(
     # A pixel averages over its footprint, where mu = sqrt(1 - r^2) varies and the silhouette
     # may cut it: the expected pixel is the mean over 32 x 32 sub-pixel midpoints of A1(mu) on
     # the sphere and 1 off it (A1 interpolated linearly from 192 quadrature values in mu,
-    # error < 4e-4 for mu >= 0.02, 0.13 SE). Taking A1 at the pixel centre instead biases the silhouette ring by
-    # +3.1 to +4.8 SE (and inner rings by up to 0.8 SE) with a correct renderer. Pixels are independent, each with its own expectation: per
+    # error < 4e-4 for mu >= 0.02, 0.13 SE). Taking A1 at the pixel centre instead biases the
+    # silhouette ring by +3.1 to +4.8 SE (and inner rings by up to 0.8 SE) with a correct
+    # renderer. Pixels are independent, each with its own expectation: per
     # ring of radius (8 rings of equal pixel count, silhouette pixels included) the residuals'
     # mean over the standard error from the residuals' spread (which agrees with the spread of
     # independent renders) must lie within 3 SE, and the sum of the 8 squares below the
