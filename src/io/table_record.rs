@@ -119,7 +119,8 @@ impl TableRecord {
     /// Reads the record of the `lut.json` at `path`.
     pub fn read(path: &std::path::Path) -> anyhow::Result<Self> {
         use anyhow::Context;
-        let text = crate::input::read_to_string(path, crate::input::MAX_CONFIG_BYTES).with_context(|| format!("cannot read {}", path.display()))?;
+        let text = crate::input::read_to_string(path, crate::input::MAX_CONFIG_BYTES)
+            .with_context(|| format!("cannot read {}", path.display()))?;
         let json: TableJson = serde_json::from_str(&text)
             .with_context(|| format!("{}: not the `lut.json` of a `smithwalk lut` table", path.display()))?;
         Ok(json.config)
