@@ -495,6 +495,23 @@ pub fn write_outputs(sim: &Simulation, config: &Config, dir: &Path) -> Result<Ve
 mod tests {
     use super::*;
 
+    /// The disk estimate a run prints before it walks (issue 36 item 16) bounds the tables it
+    /// writes: `lobes.csv`, `summary.csv` and `run.json` of a run with every slot reached.
+    #[test]
+    fn the_disk_estimate_bounds_the_tables_written() {
+        let config = crate::setup::config::Config::parse(
+            "paths = 40000\nseed = 5\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\n\
+             theta_deg = [20, 70]\n[detector]\ncos_theta_bins = 4\nphi_bins = 8\nmax_order = 3\n",
+        )
+        .unwrap();
+        let sim = crate::engine::simulate(&config, Some(1), false).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let written: u64 =
+            write_outputs(&sim, &config, dir.path()).unwrap().iter().map(|f| std::fs::metadata(f).unwrap().len()).sum();
+        let estimate = crate::engine::resources::DiskEstimate::of(&config);
+        assert!(written > 0 && written <= estimate.table_bytes, "{written} > {estimate:?}");
+    }
+
     #[test]
     fn bin_edges_are_signed_by_hemisphere_without_negative_zero() {
         let grid = Grid { cos_bins: 4, phi_bins: 3 };
