@@ -13,6 +13,7 @@ mod hammon_fit;
 mod hammon_variants;
 mod height_independence;
 mod height_walk;
+mod inside;
 mod joint_chains;
 mod next_event;
 mod position_free;

@@ -93,7 +93,13 @@ const CASES: [HistogramCase; 6] = [
 /// Beside a chi-square `test` of an order-1 histogram against `expected`: it kept at least 16
 /// cells (a lobe wrongly expected to be zero almost everywhere pools into one untested cell),
 /// and the measured order-1 albedo `(e1, se)` matches the bins' sum by a z test at `level`.
-fn assert_cells_and_albedo((e1, se): (f64, f64), test: &ChiSquare, expected: &[f64], level: f64, label: &str) {
+pub(crate) fn assert_cells_and_albedo(
+    (e1, se): (f64, f64),
+    test: &ChiSquare,
+    expected: &[f64],
+    level: f64,
+    label: &str,
+) {
     assert!(test.dof >= 16, "{label}: only {} cells tested", test.dof);
     let total: f64 = expected.iter().sum();
     println!("{label}: E1 {e1:.5} +- {se:.5}, single scattering {total:.5}");
