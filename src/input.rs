@@ -96,7 +96,9 @@ fn not_utf8(bytes: &[u8], e: std::str::Utf8Error) -> io::Error {
     };
     io::Error::new(
         io::ErrorKind::InvalidData,
-        format!("{what} at line {line}, column {column} (byte offset {offset}) is not UTF-8: the file must be UTF-8 text"),
+        format!(
+            "{what} at line {line}, column {column} (byte offset {offset}) is not UTF-8: the file must be UTF-8 text"
+        ),
     )
 }
 
@@ -124,7 +126,10 @@ mod tests {
         std::fs::write(&path, b"paths = 1\n# \xC3\xA9t\xE9\n").unwrap();
         let e = read_to_string(&path, MAX_CONFIG_BYTES).unwrap_err();
         assert_eq!(e.kind(), io::ErrorKind::InvalidData);
-        assert_eq!(e.to_string(), "the byte 0xE9 at line 2, column 5 (byte offset 16) is not UTF-8: the file must be UTF-8 text");
+        assert_eq!(
+            e.to_string(),
+            "the byte 0xE9 at line 2, column 5 (byte offset 15) is not UTF-8: the file must be UTF-8 text"
+        );
         std::fs::write(&path, b"a = \xC3").unwrap();
         let e = read_to_string(&path, MAX_CONFIG_BYTES).unwrap_err().to_string();
         assert!(e.starts_with("the end of the file, inside a character, at line 1, column 5 (byte offset 4)"), "{e}");
