@@ -77,11 +77,29 @@ pub fn read(path: &Path, limit: u64) -> io::Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// The text of `path` (UTF-8), at most `limit` bytes of it.
+/// The text of `path` (UTF-8), at most `limit` bytes of it. Bytes that are not UTF-8 are
+/// refused with the place of the first: its byte offset, line and column.
 pub fn read_to_string(path: &Path, limit: u64) -> io::Result<String> {
-    let mut text = String::new();
-    open(path, limit)?.read_to_string(&mut text)?;
-    Ok(text)
+    String::from_utf8(read(path, limit)?).map_err(|e| not_utf8(e.as_bytes(), e.utf8_error()))
+}
+
+/// The error of `bytes` that are not UTF-8 from `e.valid_up_to()` on.
+fn not_utf8(bytes: &[u8], e: std::str::Utf8Error) -> io::Error {
+    let offset = e.valid_up_to();
+    // What precedes the first bad byte is UTF-8: its lines and characters are the user's.
+    let valid = std::str::from_utf8(&bytes[..offset]).unwrap_or_default();
+    let line = valid.matches('\n').count() + 1;
+    let column = valid.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    let what = match e.error_len() {
+        Some(_) => format!("the byte 0x{:02X}", bytes[offset]),
+        None => "the end of the file, inside a character,".to_string(),
+    };
+    io::Error::new(
+        io::ErrorKind::InvalidData,
+        format!(
+            "{what} at line {line}, column {column} (byte offset {offset}) is not UTF-8: the file must be UTF-8 text"
+        ),
+    )
 }
 
 #[cfg(test)]
@@ -99,6 +117,22 @@ mod tests {
         // An endless input stops at the limit.
         let e = Bounded::new(io::repeat(0), MAX_CONFIG_BYTES).read_to_end(&mut Vec::new()).unwrap_err();
         assert_eq!(e.to_string(), "larger than 16 MiB, the most allowed");
+    }
+
+    #[test]
+    fn text_that_is_not_utf8_is_refused_with_the_place_of_its_first_bad_byte() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("latin1.toml");
+        std::fs::write(&path, b"paths = 1\n# \xC3\xA9t\xE9\n").unwrap();
+        let e = read_to_string(&path, MAX_CONFIG_BYTES).unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::InvalidData);
+        assert_eq!(
+            e.to_string(),
+            "the byte 0xE9 at line 2, column 5 (byte offset 15) is not UTF-8: the file must be UTF-8 text"
+        );
+        std::fs::write(&path, b"a = \xC3").unwrap();
+        let e = read_to_string(&path, MAX_CONFIG_BYTES).unwrap_err().to_string();
+        assert!(e.starts_with("the end of the file, inside a character, at line 1, column 5 (byte offset 4)"), "{e}");
     }
 
     #[test]

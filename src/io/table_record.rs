@@ -24,7 +24,7 @@ pub enum TableKind {
 }
 
 /// Where a table's nodes lie in each axis' interval `[lo, hi]`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum Nodes {
     /// Cell centres, `lo + (i + 1/2) (hi - lo) / n`: a texture's texel centres.
@@ -34,6 +34,8 @@ pub enum Nodes {
     /// at `lo` and `hi` returns the nodes there, with no clamp error.
     Edges,
 }
+
+crate::setup::config::deserialize_by_name!(Nodes: [Nodes::Cells, Nodes::Edges]);
 
 impl Nodes {
     /// `n` nodes of `[lo, hi]`.

@@ -1,5 +1,6 @@
 //! Every bad config gets one line naming the field, the value as written and what is allowed
-//! (never serde's "did not match any variant of untagged enum"); long inputs are quoted
+//! (never serde's "did not match any variant of untagged enum"; tests/cli/wording.rs checks each
+//! type and shape of value, with its line and column); long inputs are quoted
 //! shortened; configs beyond the documented limits (photons, roughness, threads, memory) are
 //! refused before any work, with nothing written; a run config given to `smithwalk lut`, or a
 //! table config to `smithwalk run`, says which command reads it.
@@ -24,12 +25,12 @@ fn every_bad_config_names_its_field_value_and_what_is_allowed() {
     let cases = [
         (
             with("alpha = 0.5", "alpha = 0.5\nndf = \"gaussian\""),
-            ["`surface.ndf` = \"gaussian\"", "`ggx` or `beckmann`"],
+            ["`surface.ndf` = \"gaussian\"", "\"ggx\" or \"beckmann\""],
         ),
-        (with("\"conductor\"", "\"metal\""), ["`material.kind` = \"metal\"", "`dielectric`"]),
-        (with("theta_deg = 30", "theta_deg = 30\nside = \"bottom\""), ["`incident.side` = \"bottom\"", "`inside`"]),
-        (with("alpha = 0.5", "alpha = 0.5\nsmith = \"Exact\""), ["`surface.smith` = \"Exact\"", "`exact`"]),
-        (with("alpha = 0.5", "alpha = 0.5\nnormals = \"foo\""), ["`surface.normals` = \"foo\"", "`vndf`"]),
+        (with("\"conductor\"", "\"metal\""), ["`material.kind` = \"metal\"", "\"dielectric\""]),
+        (with("theta_deg = 30", "theta_deg = 30\nside = \"bottom\""), ["`incident.side` = \"bottom\"", "\"inside\""]),
+        (with("alpha = 0.5", "alpha = 0.5\nsmith = \"Exact\""), ["`surface.smith` = \"Exact\"", "\"exact\""]),
+        (with("alpha = 0.5", "alpha = 0.5\nnormals = \"foo\""), ["`surface.normals` = \"foo\"", "\"vndf\""]),
         (with("\"conductor\"", "\"conductor\"\ncolor = 3"), ["`material.color` is not a known key", "`fresnel`"]),
         (
             with("\"conductor\"", "\"dielectric\""),
@@ -38,19 +39,28 @@ fn every_bad_config_names_its_field_value_and_what_is_allowed() {
         // A key that a Fresnel kind needs: what it must be, with no "= missing".
         (
             with("\"conductor\"", "\"conductor\"\nfresnel = \"schlick\""),
-            ["`material.f0` is missing: fresnel = \"schlick\" needs a reflectance in [0, 1]", "[r, g, b]"],
+            [
+                "`material.f0` is missing from the table at line 4, column 1: fresnel = \"schlick\" needs a reflectance in [0, 1]",
+                "[r, g, b]",
+            ],
         ),
         (
             with("\"conductor\"", "\"conductor\"\nfresnel = \"exact\"\neta = 0.2"),
-            ["`material.k` is missing: fresnel = \"exact\" needs the extinction coefficient, >= 0", "[r, g, b]"],
+            [
+                "`material.k` is missing from the table at line 4, column 1: fresnel = \"exact\" needs the extinction coefficient, >= 0",
+                "[r, g, b]",
+            ],
         ),
         (
             with("theta_deg = 30", "theta_deg = 30\ntheta_rad = 0.5"),
-            ["`incident.theta_deg` and `incident.theta_rad` are both given: give one of them", ""],
+            ["`incident.theta_deg` and `incident.theta_rad` are both given (line 8, column 1): give one of them", ""],
         ),
         (
             with("theta_deg = 30", "phi_deg = 30"),
-            ["`incident.theta_deg` is missing: a polar angle in [0, 90)", "`theta_rad`"],
+            [
+                "`incident.theta_deg` is missing from the table at line 6, column 1: a polar angle in [0, 90)",
+                "`theta_rad`",
+            ],
         ),
         // One material table is `material`, as the text names it; a list's are `material[i]`.
         (with("\"conductor\"", "\"dielectric\"\neta = 1.0"), ["`material.eta` = 1 is not allowed", "!= 1"]),
@@ -65,18 +75,18 @@ fn every_bad_config_names_its_field_value_and_what_is_allowed() {
         // the whole table (tagged by `kind`).
         (
             with("\"conductor\"", "\"diffuse\"\nalbedo = [0.5, 0.5]"),
-            ["`material.albedo` = [0.5, 0.5] is not allowed (line 6)", "three values [r, g, b]"],
+            ["`material.albedo` = [0.5, 0.5] is not allowed (line 6, column 10)", "three values [r, g, b]"],
         ),
         (
             with("\"conductor\"", "\"dielectric\"\nname = \"glass\"\neta = [1.4, 1.5, 1.6]"),
-            ["`material.eta` = [1.4, 1.5, 1.6] is not allowed (line 7)", "dispersion, is not modelled"],
+            ["`material.eta` = [1.4, 1.5, 1.6] is not allowed (line 7, column 7)", "dispersion, is not modelled"],
         ),
         (
             with(
                 "[material]\nkind = \"conductor\"",
                 "[[material]]\nkind = \"conductor\"\n[[material]]\nkind = \"conductor\"\nfresnel = \"exact\"\neta = 0.2\nk = [3.9, 2.4]",
             ),
-            ["`material[1].k` = [3.9, 2.4] is not allowed (line 10)", "three values [r, g, b]"],
+            ["`material[1].k` = [3.9, 2.4] is not allowed (line 10, column 5)", "three values [r, g, b]"],
         ),
         (
             with("alpha = 0.5", "alpha = [[0.1, 0.2, 0.3]]"),
@@ -111,11 +121,15 @@ fn every_bad_config_names_its_field_value_and_what_is_allowed() {
 fn type_errors_say_what_is_allowed_in_user_terms() {
     let with = |from: &str, to: &str| BASE.replace(from, to);
     let cases = [
-        (with("paths = 1000", "paths = 1e6"), "`paths` = 1e6 is not allowed (line 1)", "e.g. 1000000 or 1_000_000"),
+        (
+            with("paths = 1000", "paths = 1e6"),
+            "`paths` = 1e6 is not allowed (line 1, column 9)",
+            "e.g. 1000000 or 1_000_000",
+        ),
         (with("paths = 1000", "paths = -5"), "`paths` = -5 is not allowed", "an integer from 2 to 10^15"),
         (format!("{BASE}[detector]\nphi_bins = 2.5\n"), "`detector.phi_bins` = 2.5", "an integer from 1 to 4096"),
         (format!("{BASE}[detector]\nmax_order = \"3\"\n"), "`detector.max_order` = \"3\"", "an integer >= 1"),
-        (with("theta_deg = 30", "theta_deg = \"30\""), "`incident.theta_deg` = \"30\"", "expected a number"),
+        (with("theta_deg = 30", "theta_deg = \"30\""), "`incident.theta_deg` = \"30\"", "a polar angle in [0, 90)"),
     ];
     for (toml, value, allowed) in cases {
         let e = error_of(&toml);
@@ -246,11 +260,14 @@ fn a_missing_table_or_key_says_what_is_expected_with_no_output() {
     };
     let cases = [
         (without("[incident]\ntheta_deg = 30\n"), "`[incident]` is missing: a table with `theta_deg` or `theta_rad`"),
-        (without("paths = 1000\n"), "`paths` is missing: photons per case, from 2 to 10^15"),
+        (without("paths = 1000\n"), "`paths` is missing: photons per case, an integer from 2 to 10^15"),
         (without("[surface]\nalpha = 0.5\n"), "`[surface]` is missing: a table with `alpha`"),
         (without("[material]\nkind = \"conductor\"\n"), "`[material]` is missing: a table with `kind` = \"conductor\""),
-        (without("alpha = 0.5\n"), "`surface.alpha` is missing from the table at line 2: a roughness > 0"),
-        (without("kind = \"conductor\"\n"), "`material.kind` is missing from the table at line 4: \"conductor\""),
+        (without("alpha = 0.5\n"), "`surface.alpha` is missing from the table at line 2, column 1: a roughness > 0"),
+        (
+            without("kind = \"conductor\"\n"),
+            "`material.kind` is missing from the table at line 4, column 1: \"conductor\"",
+        ),
     ];
     for (config, expected) in cases {
         let (code, e) = run(&config, &[]);

@@ -9,3 +9,4 @@ mod bad_input;
 mod documented_limits;
 mod memory;
 mod properties;
+mod wording;

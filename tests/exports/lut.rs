@@ -211,11 +211,14 @@ fn bad_table_configs_name_the_field() {
 fn a_table_config_that_does_not_read_gets_one_line_naming_the_key() {
     let conductor = "\"conductor\"";
     let cases = [
-        (form(conductor, "mu_nodes = 3\npaths = 10\n"), "`table.mu_nodes` is not a known key (line 4)"),
-        (form(conductor, "mu = \"x\"\npaths = 10\n"), "`table.mu` = \"x\" is not allowed (line 4)"),
-        (form("\"metal\"", "paths = 10\n"), "`material.kind` = \"metal\" is not allowed (line 2)"),
+        (form(conductor, "mu_nodes = 3\npaths = 10\n"), "`table.mu_nodes` is not a known key (line 4, column 1)"),
+        (form(conductor, "mu = \"x\"\npaths = 10\n"), "`table.mu` = \"x\" is not allowed (line 4, column 6)"),
+        (form("\"metal\"", "paths = 10\n"), "`material.kind` = \"metal\" is not allowed (line 2, column 8)"),
         ("[material]\nkind = \"conductor\"\n".to_string(), "`[table]` is missing: a table with the grid"),
-        (form(conductor, "nodes = \"corners\"\npaths = 10\n"), "`table.nodes` = \"corners\" is not allowed (line 4)"),
+        (
+            form(conductor, "nodes = \"corners\"\npaths = 10\n"),
+            "`table.nodes` = \"corners\" is not allowed (line 4, column 9)",
+        ),
     ];
     for (toml, expected) in &cases {
         let (err, prefix) = load_error(toml);
@@ -331,11 +334,11 @@ fn a_value_the_table_sweeps_is_refused_in_surface_and_material() {
     let cases = [
         (
             format!("[surface]\nalpha = 0.5\n{}", form("\"conductor\"", "paths = 10\n")),
-            "`surface.alpha` = 0.5 is not allowed (line 2): a table sweeps alpha",
+            "`surface.alpha` = 0.5 is not allowed (line 2, column 9): a table sweeps alpha",
         ),
         (
             form("\"dielectric\"\neta = 1.5", "paths = 10\n"),
-            "`material.eta` = 1.5 is not allowed (line 3): a dielectric table sweeps eta",
+            "`material.eta` = 1.5 is not allowed (line 3, column 7): a dielectric table sweeps eta",
         ),
     ];
     for (toml, expected) in &cases {

@@ -15,7 +15,8 @@ use crate::analysis::quadrature::gauss_legendre;
 use crate::io::table_record::{Nodes, TableKind, TableRecord};
 use crate::setup::config::{
     Alpha, Channels, Config, ConfigError, DetectorConfig, EnergyConfig, FresnelKind, IncidentConfig, IncidentSide,
-    MaterialConfig, OneOrMany, PrecisionConfig, RUN_TABLES, Supplied, SurfaceConfig, invalid, parse_toml_supplied,
+    MaterialConfig, OneOrMany, PrecisionConfig, RUN_TABLES, Supplied, SurfaceConfig, invalid, locate,
+    parse_toml_supplied,
 };
 
 /// The cosine of incidence at which a node at `mu = 0` is walked: light at exactly grazing
@@ -199,8 +200,12 @@ impl LutConfig {
         };
         let kind = document.as_ref().and_then(|d| d.get("material")?.get("kind")?.as_str().map(String::from));
         let supplied = if kind.as_deref() == Some("dielectric") { vec![alpha, eta] } else { vec![alpha] };
+        if document.as_ref().and_then(|d| d.get("material")).is_some_and(toml::Value::is_array) {
+            let allowed = "one [material] table: a table is made for one facet (one config per material)";
+            return Err(locate(invalid("material", "[[material]]", allowed), text, true).in_source("<text>"));
+        }
         let mut config: LutConfig = parse_toml_supplied(text, &supplied)?;
-        config.validate().map_err(|e| e.in_source("<text>"))?;
+        config.validate().map_err(|e| locate(e, text, true).in_source("<text>"))?;
         config.surface.alpha = OneOrMany::Many(config.alpha_nodes().into_iter().map(Alpha::Isotropic).collect());
         let first_eta = config.eta_nodes().first().copied();
         if let (MaterialConfig::Dielectric { eta, .. }, Some(first)) = (&mut config.material, first_eta) {

@@ -2,14 +2,16 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::values::OneOrMany;
+use super::values::{OneOrMany, deserialize_by_name};
 
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum IncidentSide {
     Outside,
     Inside,
 }
+
+deserialize_by_name!(IncidentSide: [IncidentSide::Outside, IncidentSide::Inside]);
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]

@@ -1,10 +1,13 @@
 //! The `[material]` tables: a facet material and its parameters, tagged by `kind`.
 
+use std::fmt;
+
+use serde::de::{Error, MapAccess};
 use serde::{Deserialize, Serialize};
 
-use super::values::{Channels, number_or_list};
+use super::values::{Channels, deserialize_by_name, number_or_list};
 
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum FresnelKind {
     None,
@@ -12,53 +15,163 @@ pub enum FresnelKind {
     Exact,
 }
 
-/// A facet material (`[material]` or `[[material]]` entries), tagged by `kind`.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+deserialize_by_name!(FresnelKind: [FresnelKind::None, FresnelKind::Schlick, FresnelKind::Exact]);
+
+/// A facet material (`[material]` or `[[material]]` entries), tagged by `kind`. It is read key
+/// by key ([`MaterialConfig::deserialize`]), so that an error names the key and its value, where
+/// serde's internally tagged enums read the table whole and report it as a whole.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "lowercase")]
 pub enum MaterialConfig {
     Conductor {
-        #[serde(default = "fresnel_none")]
         fresnel: FresnelKind,
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(skip_serializing_if = "Option::is_none")]
         f0: Option<Channels>,
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(skip_serializing_if = "Option::is_none")]
         eta: Option<Channels>,
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(skip_serializing_if = "Option::is_none")]
         k: Option<Channels>,
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(skip_serializing_if = "Option::is_none")]
         name: Option<String>,
     },
     Dielectric {
-        #[serde(deserialize_with = "relative_index")]
         eta: f64,
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(skip_serializing_if = "Option::is_none")]
         name: Option<String>,
     },
     Diffuse {
-        #[serde(default = "unit_channels")]
         albedo: Channels,
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(skip_serializing_if = "Option::is_none")]
         name: Option<String>,
     },
     Hammon {
-        #[serde(default = "hammon_f0")]
         f0: Channels,
-        #[serde(default = "unit_channels")]
         albedo: Channels,
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[serde(skip_serializing_if = "Option::is_none")]
         name: Option<String>,
     },
 }
 
-/// A dielectric's `eta`: one number, so that a list gets an error that says why.
-fn relative_index<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    let what = "one number, the relative index n_inside / n_outside of every channel (an index per channel, dispersion, is not modelled)";
-    number_or_list::<D, 3>(d, what)?.map_err(|_| serde::de::Error::invalid_type(serde::de::Unexpected::Seq, &what))
+/// The `kind` of a material.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+enum Kind {
+    Conductor,
+    Dielectric,
+    Diffuse,
+    Hammon,
 }
 
-fn fresnel_none() -> FresnelKind {
-    FresnelKind::None
+deserialize_by_name!(Kind: [Kind::Conductor, Kind::Dielectric, Kind::Diffuse, Kind::Hammon]);
+
+impl Kind {
+    /// The keys a material of this kind takes.
+    fn keys(self) -> &'static [&'static str] {
+        match self {
+            Kind::Conductor => &["kind", "fresnel", "f0", "eta", "k", "name"],
+            Kind::Dielectric => &["kind", "eta", "name"],
+            Kind::Diffuse => &["kind", "albedo", "name"],
+            Kind::Hammon => &["kind", "f0", "albedo", "name"],
+        }
+    }
 }
+
+/// Every key of some kind of material.
+const KEYS: [&str; 7] = ["kind", "fresnel", "f0", "eta", "k", "albedo", "name"];
+
+/// The prefix of an error about the value of `key` in a table read whole (a material), which
+/// serde's path stops short of: `key `eta`: ...`. Reading a config
+/// ([`super::reading`]) puts the key on the path and the message after the value.
+pub(super) const KEY_ERROR: &str = "key `";
+
+fn key_error<E: Error>(key: &str, message: &str) -> E {
+    E::custom(format_args!("{KEY_ERROR}{key}`: {message}"))
+}
+
+/// What a dielectric's `eta` is: one number.
+const RELATIVE_INDEX: &str = "one number, the relative index n_inside / n_outside of every channel (an index per channel, \
+                              dispersion, is not modelled)";
+
+impl<'de> Deserialize<'de> for MaterialConfig {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = MaterialConfig;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a table with `kind` = \"conductor\", \"dielectric\", \"diffuse\" or \"hammon\"")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<MaterialConfig, A::Error> {
+                let mut kind = None;
+                let mut fresnel = None;
+                let [mut f0, mut eta, mut k, mut albedo] = [None; 4];
+                let mut name = None;
+                let mut unknown = None;
+                while let Some(key) = map.next_key::<String>()? {
+                    // Each value is read where it stands, so that its errors carry its key and place.
+                    match key.as_str() {
+                        "kind" if kind.is_none() => kind = Some(map.next_value::<Kind>()?),
+                        "fresnel" if fresnel.is_none() => fresnel = Some(map.next_value::<FresnelKind>()?),
+                        "eta" if eta.is_none() && kind == Some(Kind::Dielectric) => {
+                            eta = Some(Channels::Mono(map.next_value::<RelativeIndex>()?.0))
+                        }
+                        "f0" if f0.is_none() => f0 = Some(map.next_value::<Channels>()?),
+                        "eta" if eta.is_none() => eta = Some(map.next_value::<Channels>()?),
+                        "k" if k.is_none() => k = Some(map.next_value::<Channels>()?),
+                        "albedo" if albedo.is_none() => albedo = Some(map.next_value::<Channels>()?),
+                        "name" if name.is_none() => name = Some(map.next_value::<String>()?),
+                        key if KEYS.contains(&key) => return Err(key_error(key, "a key given once")),
+                        // Reported once the kind, which says the keys allowed, is known.
+                        _ => {
+                            map.next_value::<serde::de::IgnoredAny>()?;
+                            unknown.get_or_insert(key);
+                        }
+                    }
+                }
+                if let Some(key) = unknown {
+                    return Err(Error::unknown_field(&key, kind.map_or(&KEYS[..], Kind::keys)));
+                }
+                let kind = kind.ok_or_else(|| Error::missing_field("kind"))?;
+                let given = [
+                    ("fresnel", fresnel.is_some()),
+                    ("f0", f0.is_some()),
+                    ("eta", eta.is_some()),
+                    ("k", k.is_some()),
+                    ("albedo", albedo.is_some()),
+                ];
+                if let Some((key, _)) = given.iter().find(|(key, given)| *given && !kind.keys().contains(key)) {
+                    return Err(Error::unknown_field(key, kind.keys()));
+                }
+                Ok(match kind {
+                    Kind::Conductor => {
+                        MaterialConfig::Conductor { fresnel: fresnel.unwrap_or(FresnelKind::None), f0, eta, k, name }
+                    }
+                    Kind::Dielectric => match eta {
+                        Some(Channels::Mono(eta)) => MaterialConfig::Dielectric { eta, name },
+                        Some(Channels::Rgb(_)) => return Err(key_error("eta", RELATIVE_INDEX)),
+                        None => return Err(Error::missing_field("eta")),
+                    },
+                    Kind::Diffuse => MaterialConfig::Diffuse { albedo: albedo.unwrap_or(unit_channels()), name },
+                    Kind::Hammon => MaterialConfig::Hammon {
+                        f0: f0.unwrap_or(hammon_f0()),
+                        albedo: albedo.unwrap_or(unit_channels()),
+                        name,
+                    },
+                })
+            }
+        }
+        d.deserialize_map(Visitor)
+    }
+}
+
+/// A dielectric's `eta`: one number, so that a list gets an error that says why.
+struct RelativeIndex(f64);
+
+impl<'de> Deserialize<'de> for RelativeIndex {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        number_or_list::<D, 3>(d, RELATIVE_INDEX)?.map(RelativeIndex).map_err(|_| Error::custom(RELATIVE_INDEX))
+    }
+}
+
 fn unit_channels() -> Channels {
     Channels::Mono(1.0)
 }

@@ -30,11 +30,12 @@ pub use incident::{IncidentConfig, IncidentSide};
 pub use material::{FresnelKind, MaterialConfig};
 pub use physics::MAX_ALPHA;
 pub use precision::PrecisionConfig;
-pub use reading::{RUN_TABLES, Supplied, parse_toml, parse_toml_supplied, shorten};
-use reading::{VALUE_CHARS, parse_toml_with, required};
+pub use reading::{RUN_TABLES, Supplied, locate, parse_toml, parse_toml_supplied, shorten};
+use reading::{VALUE_CHARS, allowed_value, parse_toml_with};
 pub use surface::{HeightKind, NdfKind, NormalsKind, SmithKind, SurfaceConfig};
 use values::non_empty;
 pub use values::{Alpha, Channels, OneOrMany};
+pub(crate) use values::{deserialize_by_name, deserialize_named};
 
 /// A whole run configuration.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -94,10 +95,10 @@ impl Config {
     /// Parses and validates TOML text; errors name it `<text>`.
     pub fn parse(text: &str) -> Result<Self, ConfigError> {
         if let Ok(document) = text.parse::<toml::Table>() {
-            not_a_table_config(&document).map_err(|e| e.in_source("<text>"))?;
+            not_a_table_config(&document).map_err(|e| locate(e, text, true).in_source("<text>"))?;
         }
         let config: Config = parse_toml(text)?;
-        config.validate().map_err(|e| e.in_source("<text>"))?;
+        config.validate().map_err(|e| locate(e, text, true).in_source("<text>"))?;
         Ok(config)
     }
 
@@ -109,7 +110,7 @@ impl Config {
         let text = toml::to_string(table)
             .map_err(|e| in_dict(ConfigError::Parse { path: String::new(), message: e.to_string() }))?;
         let config: Config = parse_toml_with(&text, false).map_err(in_dict)?;
-        config.validate().map_err(in_dict)?;
+        config.validate().map_err(|e| in_dict(locate(e, &text, false)))?;
         Ok(config)
     }
 
@@ -163,7 +164,7 @@ impl Config {
             (Some(d), _) => ("incident.theta_deg", d.values(), 90.0),
             (None, Some(r)) => ("incident.theta_rad", r.values(), std::f64::consts::FRAC_PI_2),
             (None, None) => {
-                let allowed = required("incident.theta_deg").expect("described");
+                let allowed = allowed_value("incident.theta_deg").expect("described");
                 return Err(missing("incident.theta_deg", allowed));
             }
         };

@@ -3,35 +3,40 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::values::{Alpha, OneOrMany};
+use super::values::{Alpha, OneOrMany, deserialize_by_name};
 
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum NdfKind {
     Ggx,
     Beckmann,
 }
 
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum HeightKind {
     Uniform,
     Gaussian,
 }
 
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum SmithKind {
     Exact,
     Symmetric,
 }
 
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum NormalsKind {
     Vndf,
     HammonRejection,
 }
+
+deserialize_by_name!(NdfKind: [NdfKind::Ggx, NdfKind::Beckmann]);
+deserialize_by_name!(HeightKind: [HeightKind::Uniform, HeightKind::Gaussian]);
+deserialize_by_name!(SmithKind: [SmithKind::Exact, SmithKind::Symmetric]);
+deserialize_by_name!(NormalsKind: [NormalsKind::Vndf, NormalsKind::HammonRejection]);
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]

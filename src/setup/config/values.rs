@@ -202,3 +202,46 @@ pub(super) fn check_channels(
     }
     Ok(())
 }
+
+/// `names` as a list in words: `"a"`, `"a" or "b"`, `"a", "b" or "c"`, each quoted as TOML does.
+pub(crate) fn either(names: &[String]) -> String {
+    let quoted: Vec<String> = names.iter().map(|n| format!("{n:?}")).collect();
+    match quoted.split_last() {
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    }
+}
+
+/// Deserializes one of `variants` from its name (a string), as its `Serialize` writes it. Any
+/// other value is refused with the names, in the user's terms, instead of serde's "unknown
+/// variant" or "expected enum".
+pub(crate) fn deserialize_named<'de, D: serde::Deserializer<'de>, T: Copy + Serialize>(
+    d: D,
+    variants: &[T],
+) -> Result<T, D::Error> {
+    struct Visitor<'a, T>(&'a [T], String);
+    impl<'de, T: Copy + Serialize> serde::de::Visitor<'de> for Visitor<'_, T> {
+        type Value = T;
+        fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+            f.write_str(&self.1)
+        }
+        fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<T, E> {
+            self.0.iter().copied().find(|t| crate::io::output::name(t) == v).ok_or_else(|| E::custom(&self.1))
+        }
+    }
+    let names: Vec<String> = variants.iter().map(crate::io::output::name).collect();
+    d.deserialize_str(Visitor(variants, either(&names)))
+}
+
+/// Implements `Deserialize` for a unit enum by [`deserialize_named`] over all its variants.
+macro_rules! deserialize_by_name {
+    ($t:ty: [$($variant:expr),+ $(,)?]) => {
+        impl<'de> serde::Deserialize<'de> for $t {
+            fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                $crate::setup::config::deserialize_named(d, &[$($variant),+])
+            }
+        }
+    };
+}
+pub(crate) use deserialize_by_name;
