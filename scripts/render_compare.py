@@ -1,7 +1,7 @@
 """Image-space comparison of multiple-scattering BSDFs in Mitsuba 3 (docs/rendering.md,
 "Image-space comparison").
 
-    python3 scripts/render_compare.py --out out/render-compare --spp 192 --resolution 256
+    python3 scripts/render_compare.py --out out/render-compare --spp 256 --resolution 256
 
 Needs the smithwalk Python package, ``mitsuba==3.9.1`` (libLLVM 19 for ``llvm_ad_rgb``),
 ``matplotlib`` and ``flip-evaluator`` (NVIDIA FLIP). Nothing is downloaded.
@@ -51,6 +51,9 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 ALPHAS = (0.2, 0.5, 0.8, 1.0)
+# Samples per pixel per pass: an image is the mean of passes of at most this many, each with
+# its own sampler seed, which bounds the wavefront (one pass of 256 x 256 x 192 held 7 GB).
+PASS_SPP = 32
 # Sphere centres (x, y) in the plane z = 0, radius 1, in the order of ALPHAS.
 CENTRES = ((-1.15, 1.15), (1.15, 1.15), (-1.15, -1.15), (1.15, -1.15))
 # Images: name -> what the figure calls it.
@@ -70,7 +73,7 @@ def arguments(argv=None):
         description=__doc__.split("\n\n")[0], formatter_class=argparse.RawTextHelpFormatter
     )
     parser.add_argument("--out", type=Path, default=Path("out/render-compare"), help="output directory")
-    parser.add_argument("--spp", type=int, default=192, help="samples per pixel (default 192)")
+    parser.add_argument("--spp", type=int, default=256, help="samples per pixel (default 256)")
     parser.add_argument("--resolution", type=int, default=256, help="image width and height in pixels (default 256)")
     parser.add_argument(
         "--variant", default="llvm_ad_rgb", choices=["llvm_ad_rgb", "cuda_ad_rgb"], help="Mitsuba variant"
@@ -141,7 +144,7 @@ def scene_dict(mi, bsdfs, args):
                 "height": args.resolution,
                 "rfilter": {"type": "box"},
             },
-            "sampler": {"type": "independent", "sample_count": args.spp},
+            "sampler": {"type": "independent", "sample_count": min(args.spp, PASS_SPP)},
         },
     }
     for i, ((x, y), bsdf) in enumerate(zip(CENTRES, bsdfs)):
@@ -384,6 +387,17 @@ def figure(out, images, errors, results, covered, args):
     plt.close(fig)
 
 
+def render(mi, scene, spp, seed):
+    """The mean of passes of at most PASS_SPP samples per pixel (weighted by their counts);
+    pass p of image seed s has sampler seed s * 2^20 + p."""
+    total, done, p = 0.0, 0, 0
+    while done < spp:
+        count = min(PASS_SPP, spp - done)
+        image = np.array(mi.render(scene, seed=seed * 2**20 + p, spp=count), dtype=np.float64)[..., :3]
+        total, done, p = total + count * image, done + count, p + 1
+    return total / spp
+
+
 def main(argv=None):
     args = arguments(argv)
     for llvm in ("/usr/lib/llvm-19/lib/libLLVM.so.1", "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"):
@@ -415,7 +429,7 @@ def main(argv=None):
         scene = mi.load_dict(scene_dict(mi, bsdfs[name], args))
         seed = args.seed + 1 if name == "reference-seed2" else args.seed
         start = time.perf_counter()
-        image = np.array(mi.render(scene, seed=seed), dtype=np.float64)[..., :3]
+        image = render(mi, scene, args.spp, seed)
         seconds = time.perf_counter() - start
         if not np.isfinite(image).all():
             sys.exit(f"{name}: the render has {np.sum(~np.isfinite(image))} values that are not finite")
