@@ -17,9 +17,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 
 use crate::input;
-use crate::io::output::name;
 use crate::io::table_record::{TableKind, TableRecord};
 use crate::setup::cases::Case;
+use crate::setup::config::values::name;
 
 /// The quantity of `lut.csv` that the compensation models need: reflection, order 1 (single
 /// scattering) of the F = 1 conductor table.

@@ -16,17 +16,10 @@ use microsurface::ndf::Roughness;
 use microsurface::normals::Normals;
 use microsurface::smith::Smith;
 
+use crate::setup::config::values::name;
 use crate::setup::config::{Config, HeightKind, IncidentSide, MaterialConfig};
 
 pub const CHANNEL_NAMES: [&str; 3] = ["r", "g", "b"];
-
-/// The serde name of a config enum value (`"ggx"`, `"hammon-rejection"`, ...).
-pub(crate) fn name<T: Serialize>(value: &T) -> String {
-    match serde_json::to_value(value) {
-        Ok(serde_json::Value::String(s)) => s,
-        other => format!("{other:?}"),
-    }
-}
 
 /// The values of a case's leading columns ([`schema::CASE_COLUMNS`]).
 pub(crate) fn case_fields(case: &Case) -> Vec<String> {

@@ -220,7 +220,7 @@ impl LutConfig {
             MaterialConfig::Conductor { fresnel: FresnelKind::None, .. } => Ok(TableKind::Conductor),
             MaterialConfig::Conductor { fresnel, .. } => Err(invalid(
                 "material.fresnel",
-                format!("\"{}\"", crate::io::output::name(fresnel)),
+                format!("\"{}\"", crate::setup::config::values::name(fresnel)),
                 "\"none\": a conductor table is the F = 1 (Kulla-Conty) table",
             )),
             MaterialConfig::Dielectric { .. } => Ok(TableKind::Dielectric),

@@ -10,8 +10,8 @@ use serde::Serialize;
 use super::config::MU_GRAZING;
 use super::tables::{Lut, Quantity, QuantityTable};
 use crate::atomic::write_atomically;
-use crate::io::output::name;
 use crate::io::table_record::{Nodes, TableRecord};
+use crate::setup::config::values::name;
 
 /// The leading CSV fields of a quantity at eta slice `slice` (eta empty for tables without
 /// eta) and roughness `alpha`.

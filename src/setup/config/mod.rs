@@ -14,7 +14,7 @@ pub mod physics;
 mod precision;
 mod reading;
 mod surface;
-mod values;
+pub(crate) mod values;
 
 use std::path::Path;
 
@@ -33,9 +33,9 @@ pub use precision::PrecisionConfig;
 pub use reading::{RUN_TABLES, Supplied, locate, parse_toml, parse_toml_supplied, shorten};
 use reading::{VALUE_CHARS, allowed_value, parse_toml_with};
 pub use surface::{HeightKind, NdfKind, NormalsKind, SmithKind, SurfaceConfig};
+pub(crate) use values::deserialize_by_name;
 use values::non_empty;
 pub use values::{Alpha, Channels, OneOrMany};
-pub(crate) use values::{deserialize_by_name, deserialize_named};
 
 /// A whole run configuration.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]

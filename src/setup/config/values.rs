@@ -227,10 +227,10 @@ pub(crate) fn deserialize_named<'de, D: serde::Deserializer<'de>, T: Copy + Seri
             f.write_str(&self.1)
         }
         fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<T, E> {
-            self.0.iter().copied().find(|t| crate::io::output::name(t) == v).ok_or_else(|| E::custom(&self.1))
+            self.0.iter().copied().find(|t| name(t) == v).ok_or_else(|| E::custom(&self.1))
         }
     }
-    let names: Vec<String> = variants.iter().map(crate::io::output::name).collect();
+    let names: Vec<String> = variants.iter().map(name).collect();
     d.deserialize_str(Visitor(variants, either(&names)))
 }
 
@@ -239,9 +239,18 @@ macro_rules! deserialize_by_name {
     ($t:ty: [$($variant:expr),+ $(,)?]) => {
         impl<'de> serde::Deserialize<'de> for $t {
             fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-                $crate::setup::config::deserialize_named(d, &[$($variant),+])
+                $crate::setup::config::values::deserialize_named(d, &[$($variant),+])
             }
         }
     };
 }
 pub(crate) use deserialize_by_name;
+
+/// The serde name of a config enum value (`"ggx"`, `"hammon-rejection"`, ...), as configs
+/// spell it and the tables write it.
+pub(crate) fn name<T: serde::Serialize>(value: &T) -> String {
+    match serde_json::to_value(value) {
+        Ok(serde_json::Value::String(s)) => s,
+        other => format!("{other:?}"),
+    }
+}
