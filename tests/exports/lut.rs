@@ -349,7 +349,7 @@ fn a_value_the_table_sweeps_is_refused_in_surface_and_material() {
 
 /// The reflectance of a flat interface of relative index `eta` (transmitted side over incident
 /// side) at incidence cosine `mu`, from Snell's law and the s- and p-polarised amplitudes
-/// (Hecht, Optics §4.6.2), unpolarised; 1 under total internal reflection.
+/// (Hecht, Optics, section 4.6.2), unpolarised; 1 under total internal reflection.
 fn fresnel_hecht(eta: f64, mu: f64) -> f64 {
     let sin_t = (1.0 - mu * mu).sqrt() / eta;
     if sin_t >= 1.0 {
