@@ -94,7 +94,7 @@ fn rejects(from: &str, to: &str, expect: &[&str]) {
 /// (text to replace in a good config, its replacement, what the error must mention)
 const BAD_INPUT: [(&str, &str, &[&str]); 15] = [
     ("paths = 1000\n", "", &["`paths` is missing", "photons per case"]),
-    ("[surface]", "colour = 3\n[surface]", &["unknown field `colour`"]),
+    ("[surface]", "colour = 3\n[surface]", &["`colour` is not a known key", "line 2", "`surface`"]),
     ("alpha = 0.5", "alpha = -0.5", &["surface.alpha", "-0.5", "> 0"]),
     ("alpha = 0.5", "alpha = [0.5, 0.0]", &["surface.alpha", "0", "> 0"]),
     ("alpha = 0.5", "alpha = []", &["surface.alpha", "at least one value"]),
