@@ -59,13 +59,19 @@ phi_bins = 8
 
 
 @pytest.fixture(scope="session")
-def cli():
-    """Runs the `smithwalk` binary (SMITHWALK_BIN, or the repository's target/release)."""
-    binary = os.environ.get("SMITHWALK_BIN") or str(
+def binary():
+    """The `smithwalk` binary's path (SMITHWALK_BIN, or the repository's target/release)."""
+    path = os.environ.get("SMITHWALK_BIN") or str(
         Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target")) / "release" / "smithwalk"
     )
-    if not Path(binary).exists():
-        pytest.fail(f"no smithwalk binary at {binary}: run `cargo build --release` or set SMITHWALK_BIN")
+    if not Path(path).exists():
+        pytest.fail(f"no smithwalk binary at {path}: run `cargo build --release` or set SMITHWALK_BIN")
+    return path
+
+
+@pytest.fixture(scope="session")
+def cli(binary):
+    """Runs the `smithwalk` binary."""
 
     def call(*args, check=True):
         done = subprocess.run([binary, *map(str, args)], capture_output=True, text=True)
