@@ -187,6 +187,7 @@ def score_run(directory: Path, paths: int) -> pd.DataFrame:
         for order, folded in zip(scored["order"], scored["folded"])
     ]
     scored["albedo_error"] = scored["albedo_model"] - scored["albedo_measured"]
+    scored["albedo_noise"] = np.hypot(scored["albedo_measured_stderr"], scored["albedo_model_stderr"].fillna(0.0))
     # Relative variance per photon of an albedo estimate: n stderr^2 / albedo^2.
     scored["walk_var"] = paths * (scored["albedo_measured_stderr"] / scored["albedo_measured"]) ** 2
     model_albedo = scored["albedo_model"].where(scored["albedo_model"] > 0)
@@ -202,19 +203,20 @@ def describe(row) -> str:
     return f"{row.ndf} {alpha}, {row.material}{channel}, {row.side} {row.theta_i_deg:g}°"
 
 
-def worst(group: pd.DataFrame, column: str) -> str:
-    """The largest |column| of a group and the case it occurs in."""
+def worst(group: pd.DataFrame, column: str, noise: str) -> str:
+    """The largest |column| of a group, its noise level and the case it occurs in."""
     values = group[column].abs()
     if values.isna().all():
         return "—"
     row = group.loc[values.idxmax()]
-    return f"{row[column]:+.4f} ({describe(row)})" if column == "albedo_error" else f"{row[column]:.4f} ({describe(row)})"
+    sign = "+" if column == "albedo_error" else ""
+    return f"{row[column]:{sign}.4f} ± {row[noise]:.4f} ({describe(row)})"
 
 
 def table(scored: pd.DataFrame, models: list[str]) -> list[str]:
     """Markdown rows: per model, slot and hemisphere, the median and worst errors."""
     lines = [
-        "| model | order | hemi | lobes | median abs. albedo error | worst albedo error (case) | median lobe error (noise) | worst lobe error (case) |",
+        "| model | order | hemi | lobes | median abs. albedo error | worst albedo error (case) | median lobe error ± noise | worst lobe error (case) |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for model in models:
@@ -225,8 +227,8 @@ def table(scored: pd.DataFrame, models: list[str]) -> list[str]:
                     continue
                 lines.append(
                     f"| `{model}` | {slot} | {hemi} | {len(g)} | {g['albedo_error'].abs().median():.4f} | "
-                    f"{worst(g, 'albedo_error')} | {g['lobe_error'].median():.4f} ({g['lobe_noise'].median():.4f}) | "
-                    f"{worst(g, 'lobe_error')} |"
+                    f"{worst(g, 'albedo_error', 'albedo_noise')} | "
+                    f"{g['lobe_error'].median():.4f} ± {g['lobe_noise'].median():.4f} | {worst(g, 'lobe_error', 'lobe_noise')} |"
                 )
     return lines
 
@@ -270,8 +272,12 @@ def figure(scored: pd.DataFrame, models: list[str], axis: str, label: str, path:
     fig, axes = plt.subplots(2, len(slots), figsize=(3.2 * len(slots), 6.0), squeeze=False, sharex=True)
     colours = plt.get_cmap("tab10")
     for j, slot in enumerate(slots):
-        for i, (column, what) in enumerate([("albedo_error", "abs. albedo error"), ("lobe_error", "lobe error")]):
+        panels = [("albedo_error", "abs. albedo error", "albedo_noise"), ("lobe_error", "lobe error", "lobe_noise")]
+        for i, (column, what, noise) in enumerate(panels):
             ax = axes[i][j]
+            # What noise alone gives: the albedos' standard error, the lobe error's noise level.
+            floor = scored[scored["slot"] == slot].groupby(axis)[noise].median()
+            ax.plot(floor.index, floor.clip(lower=1e-5), color="0.6", ls="--", lw=1.2, label="noise level")
             for k, model in enumerate(models):
                 g = scored[(scored["model"] == model) & (scored["slot"] == slot)]
                 if g.empty:
@@ -281,7 +287,7 @@ def figure(scored: pd.DataFrame, models: list[str], axis: str, label: str, path:
             ax.set_yscale("log")
             ax.set_ylim(1e-5, 2.0)
             if i == 0:
-                ax.set_title(f"order {slot}")
+                ax.set_title("all orders" if slot == "all" else f"order {slot}")
             if i == 1:
                 ax.set_xlabel(label)
             if j == 0:
@@ -364,9 +370,11 @@ def main() -> None:
         "model's lobe from the walk's over the detector's bins, with the part that the Monte Carlo noise of both "
         "sides contributes taken out, `sqrt(max(0, Σ(m-w)² - Σ(s_m²+s_w²)) / Σw²)`: an exact model scores near 0 "
         "at any photon count, an approximation its bias. Both are median and worst over the grid, with the case of "
-        "the worst. In brackets beside the median lobe error, the median noise level: the standard deviation "
-        "of that statistic for a model without bias, `sqrt(sqrt(2 Σ(s_m²+s_w²)²) / Σw²)`; an exact model's "
-        "errors are of this size, and shrink with it as photons grow.",
+        "the worst. Beside each, what noise alone gives: for an albedo error the standard error of the "
+        "difference (the walk's, and the model's for a Monte Carlo model), for a lobe error its noise level, the standard "
+        "deviation of that statistic for a model without bias, `sqrt(sqrt(2 Σ(s_m²+s_w²)²) / Σw²)` (the median "
+        "of it beside the median). An exact model's errors are of this size and shrink with it as photons "
+        "grow; an approximation's stay.",
         "",
         "## Exact models: consistent with the walk",
         "",
@@ -383,7 +391,8 @@ def main() -> None:
         "",
         f"![median errors against incidence]({relative}/{figure_theta.name})",
         "",
-        "Median over the other parameters of the grid; errors below 1e-5 are drawn at 1e-5.",
+        "Median over the other parameters of the grid, with the median noise level dashed in grey; errors "
+        "below 1e-5 are drawn at 1e-5.",
         "",
         "## Cost",
         "",
