@@ -1,6 +1,7 @@
 //! MaterialX's GGX energy compensation (`materialx`, docs/compensation.md): Turquin's form with
 //! MaterialX's analytic fit of the directional albedo.
 //! - the fit against an independent evaluation of the shader's formula (Python, below) to 1e-12;
+//! - the model's scale of single scattering against MaterialX's formula written out here;
 //! - the fit against the exact albedo E(mu) of GGX with F = 1 by quadrature, over a grid: the
 //!   largest error is what the fit costs, and it must stay where it was measured;
 //! - `smithwalk compare --models materialx,turquin` on a small walk: the two agree within the
@@ -10,6 +11,7 @@ use crate::common;
 use crate::compensation::{case, conductor};
 
 use smithwalk::analysis::compensation::*;
+use smithwalk::microsurface::DVec3;
 use smithwalk::microsurface::ndf::Ggx;
 use smithwalk::setup::config::*;
 
@@ -40,6 +42,26 @@ fn the_fit_is_materialx_formula() {
         assert!((e - expected).abs() < 1e-12, "mu {mu}, alpha {alpha}: Albedo {e} against {expected}");
     }
     assert_eq!(Albedo::materialx(0.5).at(0.0), materialx_albedo(1e-8, 0.5));
+}
+
+/// The model's BSDF over single scattering is MaterialX's `1 + F_ss (1 - E) / E` with its
+/// Fresnel average written out here, `F_ss = F0 + (1 - F0) / 21` (`mx_fresnel_average`, F90 = 1),
+/// and `E` the fit at the *view* direction `wo` (its value from [`PYTHON`]: mu 0.5, alpha 0.3),
+/// not at the light's, not with Turquin's `F0`.
+#[test]
+fn the_scale_is_materialx_fresnel_average_and_the_views_fit() {
+    let e = 0.8267932693801004;
+    // The light at mu 0.8, the view at mu 0.5 off the plane of incidence.
+    let sin_o = 0.75f64.sqrt();
+    let (wi, wo) = (DVec3::new(0.6, 0.0, 0.8), DVec3::new(-0.6 * sin_o, 0.8 * sin_o, 0.5));
+    let albedo = Albedo::materialx(0.3);
+    for (fresnel, f0) in [(Fresnel::One, 1.0), (Fresnel::Schlick(0.5), 0.5), (Fresnel::Schlick(0.04), 0.04)] {
+        let lobe = Compensated::new(Compensation::MaterialX, Ggx::with_alpha(0.3), fresnel, &albedo, &albedo);
+        let f_ss = f0 + (1.0 - f0) / 21.0;
+        let expected = 1.0 + f_ss * (1.0 - e) / e;
+        let scale = lobe.bsdf(wi, wo) / lobe.single(wi, wo);
+        assert!((scale - expected).abs() < 1e-12, "{fresnel:?}: scale {scale} against {expected}");
+    }
 }
 
 /// The exact E(mu) of the GGX conductor with F = 1 (nested adaptive quadrature to 1e-9,
