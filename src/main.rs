@@ -72,7 +72,7 @@ enum Command {
         /// The run's output directory (with run.json, lobes.csv and summary.csv).
         run_dir: PathBuf,
         /// Comma-separated models: single, hammon-fit, heitz-nee, exact-position-free,
-        /// wang-correlated, wang-uncorrelated, kulla-conty, turquin, fdez-aguera.
+        /// wang-correlated, wang-uncorrelated, kulla-conty, turquin, fdez-aguera, materialx.
         #[arg(
             long,
             value_delimiter = ',',
@@ -99,10 +99,11 @@ enum Command {
         /// [energy_stderr]; docs/compensation.md).
         #[arg(long)]
         external: Option<PathBuf>,
-        /// Evaluate kulla-conty, turquin and fdez-aguera from this table of E(mu, alpha) and
-        /// E_avg(alpha) with F = 1 instead of exact quadrature: a `smithwalk lut` conductor
-        /// directory, or its lut.csv (quantity R_1; E_avg from lut_avg.csv beside it), bilinear,
-        /// clamped at the table's edges (docs/compensation.md).
+        /// Evaluate kulla-conty, turquin and fdez-aguera (not materialx, which has its own fit)
+        /// from this table of E(mu, alpha) and E_avg(alpha) with F = 1 instead of exact
+        /// quadrature: a `smithwalk lut` conductor directory, or its lut.csv (quantity R_1; E_avg
+        /// from lut_avg.csv beside it), bilinear, clamped at the table's edges
+        /// (docs/compensation.md).
         #[arg(long, value_name = "DIR_OR_FILE")]
         albedo_table: Option<PathBuf>,
     },

@@ -11,6 +11,12 @@
 //!   Lighting", JCGT 8(1)): single scattering plus a lobe constant in the light direction,
 //!   `F_ms E_ms / pi`, `E_ms = 1 - E(mu_v)`, `F_ms = E_F(mu_v) F_avg / (1 - E_ms F_avg)`,
 //!   `F_avg = F0 + (1 - F0) / 21`.
+//! - MaterialX's GGX energy compensation (`mx_ggx_energy_compensation` in
+//!   `libraries/pbrlib/genglsl/lib/mx_microfacet_specular.glsl`, read at AcademySoftwareFoundation/MaterialX
+//!   commit 4177b2cbd48b579ca1e8f7d9901584d811c63b68): Turquin's scale with
+//!   `F_ss = F0 + (F90 - F0) / 21` (F90 = 1 for a conductor) in place of `F0`, and `E(mu_v)` from
+//!   MaterialX's rational fit `mx_ggx_dir_albedo_analytic` ([`materialx_albedo`]) in place of
+//!   the exact albedo.
 //!
 //! `mu_v` is the cosine of the view direction of the engines, the direction the renderer's
 //! camera ray arrives from: smithwalk's outgoing direction `wo` (towards the detector), not the
@@ -44,6 +50,7 @@ pub enum Compensation {
     KullaConty,
     Turquin,
     FdezAguera,
+    MaterialX,
 }
 
 impl Compensation {
@@ -53,8 +60,15 @@ impl Compensation {
             Model::KullaConty => Some(Compensation::KullaConty),
             Model::Turquin => Some(Compensation::Turquin),
             Model::FdezAguera => Some(Compensation::FdezAguera),
+            Model::MaterialX => Some(Compensation::MaterialX),
             _ => None,
         }
+    }
+
+    /// Whether the model's `E` with F = 1 is the one a user's table (`--albedo-table`) replaces:
+    /// MaterialX ships its own fit of `E`, which is the thing its model is judged on.
+    pub fn reads_table(self) -> bool {
+        self != Compensation::MaterialX
     }
 }
 
@@ -122,10 +136,39 @@ pub fn kulla_conty_fresnel(f_avg: f64, e_avg: f64) -> f64 {
 
 /// Turquin 2019's scale of single scattering, `1 + F0 (1 - E(mu_v)) / E(mu_v)`, with `e_v`
 /// the F = 1 albedo of the view direction: with F = 1 the compensated lobe integrates to 1
-/// over the light directions.
+/// over the light directions. MaterialX passes its `F_ss` as `f0`.
 pub fn turquin_scale(f0: f64, e_v: f64) -> f64 {
     if e_v > 0.0 { 1.0 + f0 * (1.0 - e_v) / e_v } else { 1.0 }
 }
+
+/// MaterialX's rational fit of the GGX directional albedo with F = 1,
+/// `mx_ggx_dir_albedo_analytic(NdotV, alpha, 1, 1) = A + B` (see the module's commit), each of
+/// `A` and `B` a ratio of two polynomials of degree 2 in `mu` and in `alpha`, clamped to
+/// `[0, 1]` as the shader clamps them. MaterialX's `alpha` is the GGX slope width of its NDF
+/// and Smith terms (`mx_ggx_NDF`, `mx_ggx_smith_G1`; its roughness input is squared by
+/// `mx_roughness_anisotropy` before it gets there), the same parameter as smithwalk's `alpha`,
+/// so it goes in unchanged. The fit was made for `alpha` in `[0, 1]`, where MaterialX clamps it;
+/// the caller keeps it there ([`materialx_unavailable`]).
+pub fn materialx_albedo(mu: f64, alpha: f64) -> f64 {
+    let (x, y) = (mu, alpha);
+    let terms = [1.0, x, y, x * y, x * x, y * y, x * x * y, x * y * y, x * x * y * y];
+    // Rows: the numerator and denominator of A, then of B; columns: the terms above.
+    const C: [[f64; 9]; 4] = [
+        [0.1003, -0.6303, 9.748, -2.038, 29.34, -8.245, -26.44, 19.99, -5.448],
+        [1.0, -1.765, 8.263, 11.53, 28.96, -7.507, -36.11, 15.86, 33.37],
+        [0.9345, -2.323, 2.229, -3.748, 1.424, -0.7684, 1.436, 0.2913, 0.6286],
+        [1.0, 0.2281, 15.94, -55.83, 13.08, 41.26, 54.9, 300.2, -285.1],
+    ];
+    let poly = |row: &[f64; 9]| row.iter().zip(&terms).map(|(c, t)| c * t).sum::<f64>();
+    let a = (poly(&C[0]) / poly(&C[1])).clamp(0.0, 1.0);
+    let b = (poly(&C[2]) / poly(&C[3])).clamp(0.0, 1.0);
+    a + b
+}
+
+/// The MaterialX shader's floor of `NdotV` (`clamp(dot(N, V), M_FLOAT_EPS, 1.0)`, `M_FLOAT_EPS`
+/// = 1e-8 in `stdlib/genglsl/lib/mx_math.glsl`): the fit is read at it for views closer to the
+/// horizon, as the shader reads it.
+const MATERIALX_MU_MIN: f64 = 1e-8;
 
 /// Fdez-Agüera 2019's multiple-scattering lobe (a BSDF value, sr^-1), constant in the light
 /// direction: `F_ms E_ms / pi` with `E_ms = 1 - E(mu_v)` and
@@ -336,6 +379,8 @@ enum Shape {
     Panels(Vec<Panel>),
     /// A user's table ([`AlbedoTable`]): linear between `mu` nodes, clamped outside them.
     Linear { mu: Vec<f64>, e: Vec<f64> },
+    /// MaterialX's fit of GGX at this `alpha` ([`materialx_albedo`]).
+    MaterialX { alpha: f64 },
 }
 
 impl Albedo {
@@ -381,6 +426,14 @@ impl Albedo {
         Albedo { shape: Shape::Linear { mu: table.mu.clone(), e }, average }
     }
 
+    /// MaterialX's `E(mu)` of GGX at roughness `alpha` ([`materialx_albedo`]), with the
+    /// `E_avg` of that fit by adaptive quadrature.
+    pub fn materialx(alpha: f64) -> Self {
+        let shape = Shape::MaterialX { alpha };
+        let average = 2.0 * integrate(|mu| mu * materialx_albedo(mu.max(MATERIALX_MU_MIN), alpha), 0.0, 1.0, 1e-13).0;
+        Albedo { shape, average }
+    }
+
     /// `E(mu)` for `mu` in `[0, 1]` (exact: held at `E(MU_MIN)` below [`MU_MIN`], as
     /// [`directional_albedo`] is).
     pub fn at(&self, mu: f64) -> f64 {
@@ -390,6 +443,7 @@ impl Albedo {
                 panels.iter().find(|p| mu <= p.hi).unwrap_or(&panels[panels.len() - 1]).at(mu)
             }
             Shape::Linear { mu: nodes, e } => linear(nodes, e, mu),
+            Shape::MaterialX { alpha } => materialx_albedo(mu.max(MATERIALX_MU_MIN), *alpha),
         }
     }
 
@@ -409,7 +463,8 @@ pub struct Compensated<'a, N: Ndf> {
     albedo: &'a Albedo,
     /// `E_F(mu)` with the channel's Fresnel (Fdez-Agüera's `F_ss E_ss`).
     albedo_fresnel: &'a Albedo,
-    /// The model's `F_avg`: exact for Kulla & Conty, Fdez-Agüera's closed form for his.
+    /// The model's `F_avg`: exact for Kulla & Conty, Fdez-Agüera's closed form for his and
+    /// MaterialX's `F_ss`, `F0` for Turquin.
     f_avg: f64,
 }
 
@@ -420,7 +475,9 @@ impl<'a, N: Ndf> Compensated<'a, N> {
         let f_avg = match model {
             Compensation::KullaConty => fresnel_average(fresnel),
             Compensation::Turquin => fresnel.f0(),
-            Compensation::FdezAguera => fdez_aguera_fresnel_average(fresnel.f0()),
+            // MaterialX's `mx_fresnel_average` is `F0 + (F90 - F0) / 21`, with F90 = 1 for
+            // every Fresnel but its generalised Schlick: Fdez-Agüera's closed form.
+            Compensation::FdezAguera | Compensation::MaterialX => fdez_aguera_fresnel_average(fresnel.f0()),
         };
         Compensated { model, ndf, fresnel, albedo, albedo_fresnel, f_avg }
     }
@@ -445,8 +502,8 @@ impl<'a, N: Ndf> Compensated<'a, N> {
                 kulla_conty_lobe(self.albedo.at(wi.z), self.albedo.at(wo.z), e_avg)
                     * kulla_conty_fresnel(self.f_avg, e_avg)
             }
-            Compensation::Turquin => {
-                self.single(wi, wo) * (turquin_scale(self.fresnel.f0(), self.albedo.at(wo.z)) - 1.0)
+            Compensation::Turquin | Compensation::MaterialX => {
+                self.single(wi, wo) * (turquin_scale(self.f_avg, self.albedo.at(wo.z)) - 1.0)
             }
             Compensation::FdezAguera => {
                 fdez_aguera_lobe(self.albedo.at(wo.z), self.albedo_fresnel.at(wo.z), self.f_avg)
@@ -498,12 +555,35 @@ impl AlbedoCache {
 /// Whether a case is one the compensation models describe: a conductor on an isotropic
 /// surface with the true Smith Lambda and visible normals, lit from outside.
 pub fn applies(case: &Case) -> bool {
+    unavailable(case).is_none()
+}
+
+/// Why the compensation models do not describe `case` (see [`applies`]), or `None`.
+fn unavailable(case: &Case) -> Option<&'static str> {
     let Roughness { x, y } = case.roughness();
-    matches!(case.material, Material::Conductor(_))
-        && x == y
-        && case.surface.smith == Smith::Exact
-        && case.surface.normals == Normals::Visible
-        && case.side == IncidentSide::Outside
+    if !matches!(case.material, Material::Conductor(_)) {
+        Some("not a conductor")
+    } else if x != y {
+        Some("anisotropic")
+    } else if case.surface.smith != Smith::Exact || case.surface.normals != Normals::Visible {
+        Some("not the exact Smith surface")
+    } else if case.side != IncidentSide::Outside {
+        Some("light from inside")
+    } else {
+        None
+    }
+}
+
+/// Why MaterialX's compensation does not describe `case`, or `None`: besides what every
+/// compensation model needs ([`applies`]), its albedo fit is of GGX alone, and of alpha up to 1,
+/// where MaterialX clamps its roughness; beyond it the shader would render another surface
+/// than the walk's, so there is nothing of MaterialX's to judge.
+pub fn materialx_unavailable(case: &Case) -> Option<&'static str> {
+    unavailable(case).or_else(|| match case.surface.ndf {
+        AnyNdf::Ggx(_) if case.roughness().x > 1.0 => Some("alpha > 1 (MaterialX clamps alpha to 1)"),
+        AnyNdf::Ggx(_) => None,
+        AnyNdf::Beckmann(_) => Some("not GGX"),
+    })
 }
 
 /// A compensation model's all-orders lobe of a case integrated over every reflection bin
@@ -517,12 +597,19 @@ pub fn compensated_bins<const C: usize>(
     tolerance: &(dyn Fn(usize) -> f64 + Sync),
     cache: &mut AlbedoCache,
 ) -> Option<[LobeIntegrals; C]> {
-    if !applies(case) {
+    let usable = match model {
+        Compensation::MaterialX => materialx_unavailable(case).is_none(),
+        _ => applies(case),
+    };
+    if !usable {
         return None;
     }
     let channels = Fresnel::channels::<C>(&case.material)?;
     let (ndf, wi) = (case.surface.ndf, case.wi);
-    let albedo = cache.get(ndf, Fresnel::One).clone();
+    let albedo = match model {
+        Compensation::MaterialX => Albedo::materialx(ndf.roughness().x),
+        _ => cache.get(ndf, Fresnel::One).clone(),
+    };
     let peak = specular_peak(case, Hemisphere::R);
     let rule = (peak, tolerance, MAX_BIN_EVALUATIONS);
     let mut done: Vec<(Fresnel, LobeIntegrals)> = Vec::new();

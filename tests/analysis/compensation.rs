@@ -32,7 +32,7 @@ use smithwalk::setup::config::*;
 const TOL: f64 = 1e-10;
 const GRID: Grid = Grid { cos_bins: 4, phi_bins: 8 };
 
-fn conductor(fresnel: FresnelKind, f0: Option<f64>) -> MaterialConfig {
+pub(crate) fn conductor(fresnel: FresnelKind, f0: Option<f64>) -> MaterialConfig {
     MaterialConfig::Conductor { fresnel, f0: f0.map(Channels::Mono), eta: None, k: None, name: None }
 }
 
@@ -47,7 +47,7 @@ fn gold() -> MaterialConfig {
 }
 
 /// A case of `material` on an isotropic `ndf` of roughness `alpha`, lit from `theta` degrees.
-fn case(ndf: NdfKind, alpha: f64, theta: f64, material: MaterialConfig) -> Case {
+pub(crate) fn case(ndf: NdfKind, alpha: f64, theta: f64, material: MaterialConfig) -> Case {
     let mut config = Config::parse(
         "paths = 2\n[surface]\nalpha = 0.5\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 0\n",
     )

@@ -9,5 +9,6 @@ mod albedo_table;
 mod compare;
 mod compare_verdicts;
 mod compensation;
+mod materialx;
 mod models_table;
 mod sealed;

@@ -42,7 +42,7 @@ use self::report::{compare_table, models_table, report};
 pub use self::verdict::{DEFAULT_FAMILY_LEVEL, Verdict, is_exact_oracle, is_monte_carlo};
 use self::verdict::{LobeComparison, Value, compare_lobe, verdicts};
 use crate::analysis::albedo_table::AlbedoTable;
-use crate::analysis::compensation::{Compensation, applies};
+use crate::analysis::compensation::{Compensation, applies, materialx_unavailable};
 use crate::analysis::external::ExternalModel;
 use crate::analysis::models::{
     MAX_BIN_EVALUATIONS, MAX_EXIT_BIN_EVALUATIONS, hammon_fit_unavailable, single_scattering_unavailable,
@@ -164,7 +164,7 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
     let external = options.external.as_deref().map(|path| crate::analysis::external::read(path, &run)).transpose()?;
     let models = [&options.models[..], if external.is_some() { &[Model::External][..] } else { &[] }].concat();
     let albedo_table = options.albedo_table.as_deref().map(AlbedoTable::read).transpose()?;
-    if albedo_table.is_some() && !models.iter().any(|&m| Compensation::of(m).is_some()) {
+    if albedo_table.is_some() && !models.iter().any(|&m| Compensation::of(m).is_some_and(Compensation::reads_table)) {
         bail!(
             "`--albedo-table` is only read by the models kulla-conty, turquin and fdez-aguera; add one to `--models`"
         );
@@ -231,6 +231,15 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
                 bar.finish_and_clear();
                 if let Some(table) = &albedo_table {
                     notes.push((model, table.describe()));
+                }
+                p
+            }
+            Model::MaterialX => {
+                let bar = model_progress(model, terminal);
+                let p = compensation(model, &run, &measured, None, &bar);
+                bar.finish_and_clear();
+                if let Some(note) = skipped_cases(&run.cases, materialx_unavailable) {
+                    notes.push((model, note));
                 }
                 p
             }

@@ -77,6 +77,7 @@ const FOREST: RGBColor = RGBColor(0x11, 0x77, 0x33);
 const OLIVE: RGBColor = RGBColor(0x99, 0x99, 0x33);
 const ROSE: RGBColor = RGBColor(0xee, 0x66, 0x77);
 const BROWN: RGBColor = RGBColor(0x8c, 0x51, 0x0a);
+const SKY: RGBColor = RGBColor(0x56, 0xb4, 0xe9);
 const GREY: RGBColor = RGBColor(0x77, 0x77, 0x77);
 
 const fn line(colour: RGBColor, dash: Dash) -> LineStyle {
@@ -95,6 +96,7 @@ pub fn model_style(model: Model) -> LineStyle {
         Model::KullaConty => line(GREEN, Dash::Dashed),
         Model::Turquin => line(OLIVE, Dash::Dotted),
         Model::FdezAguera => line(ROSE, Dash::Dotted),
+        Model::MaterialX => line(SKY, Dash::Dashed),
         Model::External => line(BROWN, Dash::LongDash),
     }
 }

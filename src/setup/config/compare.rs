@@ -18,12 +18,14 @@ pub enum Model {
     Turquin,
     /// Energy compensation of Fdez-Agüera 2019, all orders.
     FdezAguera,
+    /// MaterialX's GGX energy compensation (Turquin's form with its albedo fit), all orders.
+    MaterialX,
     /// A user's own model read from a file (`smithwalk compare --external`); not in [`Model::ALL`].
     External,
 }
 
 impl Model {
-    pub const ALL: [Model; 9] = [
+    pub const ALL: [Model; 10] = [
         Model::Single,
         Model::HammonFit,
         Model::HeitzNee,
@@ -33,6 +35,7 @@ impl Model {
         Model::KullaConty,
         Model::Turquin,
         Model::FdezAguera,
+        Model::MaterialX,
     ];
 
     pub fn name(self) -> &'static str {
@@ -46,6 +49,7 @@ impl Model {
             Model::KullaConty => "kulla-conty",
             Model::Turquin => "turquin",
             Model::FdezAguera => "fdez-aguera",
+            Model::MaterialX => "materialx",
             Model::External => "external",
         }
     }
@@ -77,7 +81,7 @@ impl Model {
 #[serde(deny_unknown_fields)]
 pub struct CompareConfig {
     /// Model names: `single`, `hammon-fit`, `heitz-nee`, `exact-position-free`, `wang-correlated`,
-    /// `wang-uncorrelated`, `kulla-conty`, `turquin`, `fdez-aguera`.
+    /// `wang-uncorrelated`, `kulla-conty`, `turquin`, `fdez-aguera`, `materialx`.
     pub models: Vec<String>,
     /// Photons per case for the Monte Carlo models (default: the run's `paths`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
