@@ -5,11 +5,18 @@
 //!   the §7.3 example (0.2941) among them, four with one turn and four with two;
 //! * (b) on paths with a single down-to-up turn, against the exact depth factor `S` of §7.1
 //!   (the depth profile's escape probability over the product of the rates), to 1e-12;
-//! * the chain's visibility deposits `prod_{j<k} lambda_j * T` at each upward direction.
+//! * the chain's visibility deposits `prod_{j<k} lambda_j * T` at each upward direction;
+//! * a conductor's path never turns twice (§7.3): an upward direction reflected on a visible
+//!   normal drawn for it stays upward (GGX and Beckmann, anisotropic, 10^5 directions each).
 
+use microsurface::DVec3;
 use microsurface::chain::Visibility;
 use microsurface::cui::{ReleasedPath, path_term};
+use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 use microsurface::position_free::DepthProfile;
+use microsurface::random::open01;
+use rand::SeedableRng;
+use rand_pcg::Pcg64Mcg;
 
 /// `(rates lambda_0..lambda_k, pattern of d_0..d_k, T)`. T was computed by a Python port written
 /// from the C++ (plain Python floats, double precision; the C++ computes in single precision):
@@ -120,5 +127,30 @@ fn the_chain_visibility_deposits_the_released_weight() {
         }
         carried *= visibility.carried(escaped);
         assert!(carried > 0.0 && carried <= 1.0);
+    }
+}
+
+/// Reflects upward directions `d` (travelling up, uniform over the upper hemisphere) on normals
+/// drawn from the visible normals seen from `-d` (as the chain draws them) and returns the
+/// smallest rise `d'_z - d_z`, which §7.3 proves positive.
+fn smallest_rise<N: Ndf>(ndf: &N, seed: u64) -> f64 {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let mut smallest = f64::INFINITY;
+    for _ in 0..100_000 {
+        let (z, phi) = (open01(&mut rng), std::f64::consts::TAU * open01(&mut rng));
+        let s = (1.0 - z * z).sqrt();
+        let d = DVec3::new(s * phi.cos(), s * phi.sin(), z);
+        let m = ndf.sample_visible(-d, &mut rng);
+        let reflected = d - 2.0 * d.dot(m) * m;
+        smallest = smallest.min(reflected.z - d.z);
+    }
+    smallest
+}
+
+#[test]
+fn a_conductor_path_never_turns_down_again() {
+    let rough = Roughness { x: 1.2, y: 0.4 };
+    for (name, rise) in [("GGX", smallest_rise(&Ggx(rough), 71)), ("Beckmann", smallest_rise(&Beckmann(rough), 72))] {
+        assert!(rise > 0.0, "{name}: an upward direction reflected downwards (rise {rise})");
     }
 }
