@@ -10,7 +10,8 @@
 //! expectation is §7.1's with `T` in place of `S`, which is what [`ReleasedPath`] estimates on
 //! the chain of [`crate::chain`], whose directions are drawn by the same laws (the last one
 //! drawn too: the same integral, another estimator of it). `T` equals `S` for paths with one
-//! down-to-up turn and not for two or more turns (§7.3).
+//! down-to-up turn and not for two or more turns (§7.3); a conductor's paths have one turn (a
+//! reflection keeps an upward direction upward), so on them the model is exact.
 
 use crate::chain::Visibility;
 use crate::position_free::DepthProfile;
