@@ -41,6 +41,7 @@ MODEL_STYLE = {
     "exact-position-free": ("#d55e00", (0, (7, 2))),
     "wang-correlated": ("#cc79a7", "-"),
     "wang-uncorrelated": ("#332288", (0, (1, 1.5))),
+    "cui2023-released": ("#3300ff", (0, (3.5, 2))),
     "kulla-conty": ("#009e73", (0, (3.5, 2))),
     "turquin": ("#999933", (0, (1, 1.5))),
     "fdez-aguera": ("#ee6677", (0, (1, 1.5))),

@@ -48,8 +48,8 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
-EXACT = ["single", "heitz-nee", "exact-position-free"]
-MONTE_CARLO = ["heitz-nee", "exact-position-free", "wang-correlated", "wang-uncorrelated"]
+EXACT = ["single", "heitz-nee", "exact-position-free", "cui2023-released"]
+MONTE_CARLO = ["heitz-nee", "exact-position-free", "wang-correlated", "wang-uncorrelated", "cui2023-released"]
 LEVEL = 0.01
 SLOTS = ["1", "2", "3", "4+", "all"]
 LOBE_KEYS = ["case", "order", "hemisphere"]

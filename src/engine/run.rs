@@ -9,6 +9,7 @@ use std::sync::mpsc;
 
 use indicatif::ProgressBar;
 use microsurface::chain::{self, Escapes, Visibility};
+use microsurface::cui::ReleasedPath;
 use microsurface::facet::Facet;
 use microsurface::material::Material;
 use microsurface::ndf::{AnyNdf, Beckmann, Ggx, Ndf};
@@ -64,9 +65,12 @@ pub enum Estimator {
     /// The exact position-free chain (§7.1). Cases it does not describe
     /// ([`Case::position_free_applies`]) are skipped: their photons deposit nothing.
     PositionFree,
+    /// The chain of Cui et al.'s released code (§7.3). Cases it does not describe
+    /// ([`Case::cui_released_applies`]) are skipped: their photons deposit nothing.
+    CuiReleased,
     /// Up to three chain models on one chain of directions, model `c` in channel `c` of an
     /// RGB detector (mono cases only; see [`chain::trace`]). Where the position-free chain
-    /// does not apply, its channel follows the first model and means nothing.
+    /// or Cui's does not apply, its channel follows the first model and means nothing.
     JointChains([ChainModel; 3]),
 }
 
@@ -75,6 +79,7 @@ pub enum Estimator {
 pub enum ChainModel {
     Wang(Shadowing),
     PositionFree,
+    CuiReleased,
 }
 
 impl ChainModel {
@@ -83,6 +88,7 @@ impl ChainModel {
         match self {
             ChainModel::Wang(s) => Estimator::Wang(s),
             ChainModel::PositionFree => Estimator::PositionFree,
+            ChainModel::CuiReleased => Estimator::CuiReleased,
         }
     }
 }
@@ -92,6 +98,7 @@ impl ChainModel {
 enum ChainVisibility {
     Wang(Shadowing),
     PositionFree(DepthProfile),
+    CuiReleased(ReleasedPath),
 }
 
 impl ChainVisibility {
@@ -102,6 +109,10 @@ impl ChainVisibility {
                 ChainVisibility::PositionFree(DepthProfile::default())
             }
             ChainModel::PositionFree => Self::of(fallback, case, ChainModel::Wang(Shadowing::Correlated)),
+            ChainModel::CuiReleased if case.cui_released_applies() => {
+                ChainVisibility::CuiReleased(ReleasedPath::default())
+            }
+            ChainModel::CuiReleased => Self::of(fallback, case, ChainModel::Wang(Shadowing::Correlated)),
         }
     }
 }
@@ -111,6 +122,7 @@ impl Visibility for ChainVisibility {
         match self {
             ChainVisibility::Wang(s) => s.enter(rate),
             ChainVisibility::PositionFree(p) => p.enter(rate),
+            ChainVisibility::CuiReleased(c) => c.enter(rate),
         }
     }
 
@@ -118,6 +130,15 @@ impl Visibility for ChainVisibility {
         match self {
             ChainVisibility::Wang(s) => s.leave(rate_in, rate_out, up, refracted),
             ChainVisibility::PositionFree(p) => p.leave(rate_in, rate_out, up, refracted),
+            ChainVisibility::CuiReleased(c) => c.leave(rate_in, rate_out, up, refracted),
+        }
+    }
+
+    fn carried(&self, escaped: f64) -> f64 {
+        match self {
+            ChainVisibility::Wang(s) => s.carried(escaped),
+            ChainVisibility::PositionFree(p) => p.carried(escaped),
+            ChainVisibility::CuiReleased(c) => c.carried(escaped),
         }
     }
 }
@@ -132,6 +153,10 @@ impl<const C: usize> Escapes<C> for PerChannel<C> {
 
     fn escaping(&mut self, rate_in: f64, rate_out: f64, up: bool, refracted: bool) -> [f64; C] {
         std::array::from_fn(|c| self.0[c].leave(rate_in, rate_out, up, refracted))
+    }
+
+    fn carrying(&self, escaped: &[f64; C]) -> [f64; C] {
+        std::array::from_fn(|c| self.0[c].carried(escaped[c]))
     }
 }
 
@@ -350,6 +375,7 @@ where
         let mut stack = Vec::new();
         let mut nee_rng = chunk_rng(w.settings.seed ^ NEE_STREAMS, w.case.index, chunk);
         let mut profile = DepthProfile::default();
+        let mut released = ReleasedPath::default();
         let mut joint = match w.settings.estimator {
             Estimator::JointChains(models) => {
                 Some(PerChannel(std::array::from_fn(|c| ChainVisibility::of(models[c], w.case, models[0]))))
@@ -365,6 +391,10 @@ where
                 Estimator::PositionFree if !w.case.position_free_applies() => 0,
                 Estimator::PositionFree => {
                     chain::trace(&mut profile, &w.surface.ndf, &w.facet, policy, wi, &mut rng, detector)
+                }
+                Estimator::CuiReleased if !w.case.cui_released_applies() => 0,
+                Estimator::CuiReleased => {
+                    chain::trace(&mut released, &w.surface.ndf, &w.facet, policy, wi, &mut rng, detector)
                 }
                 Estimator::JointChains(_) => {
                     let joint = joint.as_mut().expect("built above for joint chains");

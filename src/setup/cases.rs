@@ -49,6 +49,12 @@ impl Case {
     pub fn position_free_applies(&self) -> bool {
         !self.material.transmits() && self.surface.smith == Smith::Exact && self.surface.normals == Normals::Visible
     }
+
+    /// Whether Cui et al.'s released model (docs/theory.md §7.3) describes this case: conductors,
+    /// where the position-free form applies (the released code is a rough-conductor BRDF).
+    pub fn cui_released_applies(&self) -> bool {
+        matches!(self.material, Material::Conductor(_)) && self.position_free_applies()
+    }
 }
 
 /// The cases of a configuration, in the order ndf, alpha, height, smith, normals, material,

@@ -18,7 +18,8 @@ use crate::smith::Smith;
 use crate::walk::{EnergyPolicy, Loss, Observer, RUNAWAY_ORDER, choose, roulette};
 
 /// What escapes after each vertex of a chain: the alternatives are Wang et al.'s local models
-/// ([`crate::wang::Shadowing`]) and the exact depth profile ([`crate::position_free`]).
+/// ([`crate::wang::Shadowing`]), the exact depth profile ([`crate::position_free`]) and the path
+/// term of Cui et al.'s released code ([`crate::cui`]).
 pub trait Visibility {
     /// Starts a photon that enters along a direction of depth rate `rate` (§2.4).
     fn enter(&mut self, rate: f64);
@@ -28,6 +29,13 @@ pub trait Visibility {
     /// or into it, having arrived along a direction of depth rate `rate_in`; `refracted` tells
     /// whether the vertex changed side. A direction into the surface escapes nothing.
     fn leave(&mut self, rate_in: f64, rate_out: f64, up: bool, refracted: bool) -> f64;
+
+    /// The fraction of the chain's weight that goes on after the last [`Visibility::leave`],
+    /// which let `escaped` escape: by default what did not escape (light that escapes leaves
+    /// the chain). A model whose escapes do not deplete the path ([`crate::cui`]) says otherwise.
+    fn carried(&self, escaped: f64) -> f64 {
+        1.0 - escaped
+    }
 }
 
 /// What escapes after each vertex, channel by channel of the chain's weight: one
@@ -39,6 +47,9 @@ pub trait Escapes<const C: usize> {
 
     /// The fraction of each channel's weight that escapes: [`Visibility::leave`] per channel.
     fn escaping(&mut self, rate_in: f64, rate_out: f64, up: bool, refracted: bool) -> [f64; C];
+
+    /// The fraction of each channel's weight that goes on: [`Visibility::carried`] per channel.
+    fn carrying(&self, escaped: &[f64; C]) -> [f64; C];
 }
 
 impl<V: Visibility, const C: usize> Escapes<C> for V {
@@ -48,6 +59,10 @@ impl<V: Visibility, const C: usize> Escapes<C> for V {
 
     fn escaping(&mut self, rate_in: f64, rate_out: f64, up: bool, refracted: bool) -> [f64; C] {
         [self.leave(rate_in, rate_out, up, refracted); C]
+    }
+
+    fn carrying(&self, escaped: &[f64; C]) -> [f64; C] {
+        escaped.map(|p| self.carried(p))
     }
 }
 
@@ -118,8 +133,9 @@ where
         }
         if p.iter().any(|&p| p > 0.0) {
             observer.escape(order, side, d, &std::array::from_fn(|c| weight[c] * p[c]));
-            weight = std::array::from_fn(|c| weight[c] * (1.0 - p[c]));
         }
+        let carried = visibility.carrying(&p);
+        weight = std::array::from_fn(|c| weight[c] * carried[c]);
         match roulette(&weight, policy.threshold, rng) {
             Some(w) => weight = w,
             None => return u64::from(order),

@@ -43,7 +43,7 @@
 //! * the walk: [`walk::Microsurface::trace`] with an [`walk::Observer`] and an
 //!   [`walk::EnergyPolicy`];
 //! * the oracles: [`single`] (exact single scattering), [`nee`] (next-event estimation),
-//!   [`position_free`], [`wang`].
+//!   [`position_free`], [`wang`], [`cui`].
 //!
 //! Directions are [`DVec3`] (glam's, re-exported), pointing away from the surface (§0); a
 //! `const C: usize` parameter is the number of colour channels (1 or 3). The version policy
@@ -53,6 +53,7 @@
 pub mod beta;
 pub mod bsdf;
 pub mod chain;
+pub mod cui;
 pub mod facet;
 pub mod fresnel;
 pub mod height;

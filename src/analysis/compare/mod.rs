@@ -4,7 +4,8 @@
 //! Models: `single` (exact single scattering by quadrature, order 1, every facet material with
 //! the true Smith Lambda and visible normals), `heitz-nee` (next-event estimation along the
 //! walk, every order), `exact-position-free` (the walk with its depths integrated out, §7.1, for
-//! one-sided facets): these three are exact for the Smith walk, so a rejection says the
+//! one-sided facets), `cui2023-released` (Cui et al. 2023 as its released code computes it,
+//! conductors, §7.3): these four are exact for the Smith walk, so a rejection says the
 //! measurement (or the oracle) is wrong. `wang-correlated` and `wang-uncorrelated` (the Wang et
 //! al. 2022 chains) and `hammon-fit` (Hammon 2017's closed-form fit of his facet, order 1 and all
 //! orders) are approximations: their rejections measure how far they are from the walk. The
@@ -34,8 +35,8 @@ use indicatif::{ProgressBar, ProgressFinish, ProgressStyle};
 
 use self::lobe::{channel_index, folded_slot, hemisphere_name, is_tested};
 use self::predict::{
-    ModelLobe, Predictions, QUADRATURE_FRACTION, chain_model, closed_form, compensation, cpu_seconds, external_lobes,
-    joint_chains, model_seed, monte_carlo, skipped_cases,
+    ModelLobe, Predictions, QUADRATURE_FRACTION, chain_model, closed_form, compensation, cpu_seconds,
+    cui_released_unavailable, external_lobes, joint_chains, model_seed, monte_carlo, skipped_cases,
 };
 pub use self::report::p_value_text;
 use self::report::{compare_table, models_table, report};
@@ -245,6 +246,11 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
             }
             Model::External => external_lobes(external.as_ref()),
             _ => {
+                if model == Model::CuiReleased
+                    && let Some(note) = skipped_cases(&run.cases, cui_released_unavailable)
+                {
+                    notes.push((model, note));
+                }
                 match joint.as_mut().and_then(|j| j.iter().position(|(m, _)| *m == model).map(|i| j.swap_remove(i).1)) {
                     Some(p) => p,
                     None => monte_carlo(model, &config, seed, options.threads, terminal)?,

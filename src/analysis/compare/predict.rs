@@ -195,9 +195,20 @@ fn simulate_model(
 }
 
 /// Whether a Monte Carlo model describes `case`: the exact position-free chain only one-sided
-/// facets ([`Case::position_free_applies`]), the others every case.
+/// facets ([`Case::position_free_applies`]), Cui's released model only conductors
+/// ([`Case::cui_released_applies`]), the others every case.
 fn describes(model: Model, case: &Case) -> bool {
-    model != Model::ExactPositionFree || case.position_free_applies()
+    match model {
+        Model::ExactPositionFree => case.position_free_applies(),
+        Model::CuiReleased => case.cui_released_applies(),
+        _ => true,
+    }
+}
+
+/// Why Cui et al.'s released model does not describe `case`, if it does not (for
+/// [`skipped_cases`]): the released code is a rough-conductor BRDF (docs/theory.md §7.3).
+pub(super) fn cui_released_unavailable(case: &Case) -> Option<&'static str> {
+    (!case.cui_released_applies()).then_some("not a conductor with the true Smith Lambda and visible normals")
 }
 
 /// The seed of a Monte Carlo model's streams: the run's seed mixed with the model's name (FNV-1a),
@@ -213,13 +224,15 @@ pub(super) fn chain_model(model: Model) -> Option<ChainModel> {
         Model::WangCorrelated => Some(ChainModel::Wang(Shadowing::Correlated)),
         Model::WangUncorrelated => Some(ChainModel::Wang(Shadowing::Uncorrelated)),
         Model::ExactPositionFree => Some(ChainModel::PositionFree),
+        Model::CuiReleased => Some(ChainModel::CuiReleased),
         _ => None,
     }
 }
 
 /// The lobes of the chain models among `models`, walked on one chain of directions (model `c`
-/// in channel `c`, [`Estimator::JointChains`]) when all three are asked for and the run is
-/// mono; empty otherwise (each is then walked alone). Two models would pay for the third
+/// in channel `c`, [`Estimator::JointChains`]) when three or more are asked for and the run is
+/// mono (the first three in the canonical order; a fourth is walked alone); empty otherwise
+/// (each is then walked alone). Two models would pay for the third
 /// channel of the RGB detector and gain nothing: measured on the quickstart, the three take
 /// 6.6 s together against 9.1 s alone, two about as long together as alone. Each model's
 /// estimator is the one it has alone but for the random numbers, and Russian roulette plays on
@@ -232,8 +245,12 @@ pub(super) fn joint_chains(
 ) -> Result<Vec<(Model, Predictions)>> {
     // Channels in the models' canonical order, so that the joint walk depends on which models
     // share it, not on the order they were asked for in.
-    let chained: Vec<(Model, ChainModel)> =
-        Model::ALL.iter().filter(|m| models.contains(m)).filter_map(|&m| chain_model(m).map(|c| (m, c))).collect();
+    let chained: Vec<(Model, ChainModel)> = Model::ALL
+        .iter()
+        .filter(|m| models.contains(m))
+        .filter_map(|&m| chain_model(m).map(|c| (m, c)))
+        .take(3)
+        .collect();
     if config.is_rgb() || chained.len() < 3 {
         return Ok(Vec::new());
     }

@@ -16,13 +16,23 @@ pub(super) const MIN_COUNT: f64 = 5.0;
 /// Whether a model is exact for the Smith walk, so that its rejection is a failure (of the
 /// measurement or of the model's code) rather than a measure of an approximation.
 pub fn is_exact_oracle(model: Model) -> bool {
-    matches!(model, Model::Single | Model::HeitzNee | Model::ExactPositionFree)
+    // Cui et al.'s released term equals the exact depth factor on every path a conductor's
+    // chain produces (one down-to-up turn: a reflection keeps an upward direction upward,
+    // docs/theory.md §7.3).
+    matches!(model, Model::Single | Model::HeitzNee | Model::ExactPositionFree | Model::CuiReleased)
 }
 
 /// Whether a model is estimated by a Monte Carlo walk (with its own standard errors), not
 /// integrated in closed form.
 pub fn is_monte_carlo(model: Model) -> bool {
-    matches!(model, Model::HeitzNee | Model::ExactPositionFree | Model::WangCorrelated | Model::WangUncorrelated)
+    matches!(
+        model,
+        Model::HeitzNee
+            | Model::ExactPositionFree
+            | Model::WangCorrelated
+            | Model::WangUncorrelated
+            | Model::CuiReleased
+    )
 }
 
 /// One model's verdict on a run.
@@ -129,6 +139,6 @@ mod tests {
     #[test]
     fn exact_oracles_are_the_models_exact_for_the_smith_walk() {
         let exact: Vec<&str> = Model::ALL.into_iter().filter(|&m| is_exact_oracle(m)).map(Model::name).collect();
-        assert_eq!(exact, ["single", "heitz-nee", "exact-position-free"]);
+        assert_eq!(exact, ["single", "heitz-nee", "exact-position-free", "cui2023-released"]);
     }
 }

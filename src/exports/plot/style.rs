@@ -79,6 +79,8 @@ const ROSE: RGBColor = RGBColor(0xee, 0x66, 0x77);
 const BROWN: RGBColor = RGBColor(0x8c, 0x51, 0x0a);
 const SKY: RGBColor = RGBColor(0x56, 0xb4, 0xe9);
 const GREY: RGBColor = RGBColor(0x77, 0x77, 0x77);
+/// Saturated blue-violet: the colour farthest from all the others in the three visions.
+const ULTRAMARINE: RGBColor = RGBColor(0x33, 0x00, 0xff);
 
 const fn line(colour: RGBColor, dash: Dash) -> LineStyle {
     LineStyle { colour, dash, width: 2, marker: Marker::None }
@@ -93,6 +95,7 @@ pub fn model_style(model: Model) -> LineStyle {
         Model::ExactPositionFree => line(VERMILLION, Dash::LongDash),
         Model::WangCorrelated => line(PURPLE, Dash::Solid),
         Model::WangUncorrelated => line(INDIGO, Dash::Dotted),
+        Model::CuiReleased => line(ULTRAMARINE, Dash::Dashed),
         Model::KullaConty => line(GREEN, Dash::Dashed),
         Model::Turquin => line(OLIVE, Dash::Dotted),
         Model::FdezAguera => line(ROSE, Dash::Dotted),

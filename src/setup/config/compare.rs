@@ -12,6 +12,8 @@ pub enum Model {
     WangCorrelated,
     WangUncorrelated,
     ExactPositionFree,
+    /// Cui et al. 2023 as its released code computes it, conductors (docs/theory.md §7.3).
+    CuiReleased,
     /// Energy compensation of Kulla & Conty 2017, all orders (`analysis::compensation`).
     KullaConty,
     /// Energy compensation of Turquin 2019, all orders.
@@ -25,13 +27,14 @@ pub enum Model {
 }
 
 impl Model {
-    pub const ALL: [Model; 10] = [
+    pub const ALL: [Model; 11] = [
         Model::Single,
         Model::HammonFit,
         Model::HeitzNee,
         Model::WangCorrelated,
         Model::WangUncorrelated,
         Model::ExactPositionFree,
+        Model::CuiReleased,
         Model::KullaConty,
         Model::Turquin,
         Model::FdezAguera,
@@ -46,6 +49,7 @@ impl Model {
             Model::WangCorrelated => "wang-correlated",
             Model::WangUncorrelated => "wang-uncorrelated",
             Model::ExactPositionFree => "exact-position-free",
+            Model::CuiReleased => "cui2023-released",
             Model::KullaConty => "kulla-conty",
             Model::Turquin => "turquin",
             Model::FdezAguera => "fdez-aguera",
@@ -55,11 +59,12 @@ impl Model {
     }
 
     /// Why the model cannot judge a run walked with Russian roulette below `threshold`
-    /// (`energy.threshold`), if it cannot: the exact position-free chain (§7.1) ends only by
-    /// that roulette once its weight is small, so with no threshold its chains run on through
-    /// weights that no longer change the lobes.
+    /// (`energy.threshold`), if it cannot: the exact position-free chain (§7.1), and Cui's
+    /// released model which carries the same weight (§7.3), end only by that roulette once
+    /// their weight is small, so with no threshold their chains run on through weights that no
+    /// longer change the lobes.
     pub fn refuses_threshold(self, threshold: f64) -> Option<String> {
-        (self == Model::ExactPositionFree && threshold <= 0.0).then(|| {
+        (matches!(self, Model::ExactPositionFree | Model::CuiReleased) && threshold <= 0.0).then(|| {
             format!(
                 "{} needs energy.threshold > 0 (its chains end only by Russian roulette below it), \
                  and the run's is {threshold}: walk it with a threshold (0.1 is the default)",
@@ -81,7 +86,7 @@ impl Model {
 #[serde(deny_unknown_fields)]
 pub struct CompareConfig {
     /// Model names: `single`, `hammon-fit`, `heitz-nee`, `exact-position-free`, `wang-correlated`,
-    /// `wang-uncorrelated`, `kulla-conty`, `turquin`, `fdez-aguera`, `materialx`.
+    /// `wang-uncorrelated`, `cui2023-released`, `kulla-conty`, `turquin`, `fdez-aguera`, `materialx`.
     pub models: Vec<String>,
     /// Photons per case for the Monte Carlo models (default: the run's `paths`).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -1,10 +1,11 @@
 //! Whole walks against oracles that do not share their code: per-order lobes, the bookkeeping of
-//! weight, reciprocity and the position-free depth profile. One test binary (each file a module)
-//! so that the crate is linked once.
+//! weight, reciprocity, the position-free depth profile and the path term of Cui et al.'s
+//! released code. One test binary (each file a module) so that the crate is linked once.
 
 #[path = "../common/mod.rs"]
 mod common;
 
+mod cui_path_term;
 mod depth_profile;
 mod reciprocity;
 mod walk_bookkeeping;
