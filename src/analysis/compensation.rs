@@ -486,6 +486,7 @@ impl AlbedoCache {
                     (Some(table), _) if f == Fresnel::One => Albedo::from_table(table, ndf.roughness().x),
                     (_, AnyNdf::Ggx(ndf)) => Albedo::exact(&ndf, f),
                     (_, AnyNdf::Beckmann(ndf)) => Albedo::exact(&ndf, f),
+                    (_, AnyNdf::StudentT(_)) => unreachable!("compensation::applies refuses Student-T"),
                 };
                 self.entries.push((key, albedo));
                 self.entries.len() - 1
@@ -495,11 +496,13 @@ impl AlbedoCache {
     }
 }
 
-/// Whether a case is one the compensation models describe: a conductor on an isotropic
-/// surface with the true Smith Lambda and visible normals, lit from outside.
+/// Whether a case is one the compensation models describe: a conductor on an isotropic GGX or
+/// Beckmann surface with the true Smith Lambda and visible normals, lit from outside (their
+/// albedo tables and tests do not cover Student-T).
 pub fn applies(case: &Case) -> bool {
     let Roughness { x, y } = case.roughness();
     matches!(case.material, Material::Conductor(_))
+        && !matches!(case.surface.ndf, AnyNdf::StudentT(_))
         && x == y
         && case.surface.smith == Smith::Exact
         && case.surface.normals == Normals::Visible
@@ -544,6 +547,7 @@ pub fn compensated_bins<const C: usize>(
                 let lobe = Compensated::new(model, ndf, f, &albedo, &albedo_fresnel);
                 integrate_bins(case, grid, Hemisphere::R, rule, |wo| lobe.bsdf(wi, wo) * wo.z)
             }
+            AnyNdf::StudentT(_) => unreachable!("compensation::applies refuses Student-T"),
         };
         done.push((f, lobe.clone()));
         lobe
