@@ -503,6 +503,7 @@ mod tests {
                             let (u, phi) = match case.surface.ndf {
                                 AnyNdf::Ggx(ndf) => widths(specular_part(&ndf, &case.material, 0, wi).unwrap()),
                                 AnyNdf::Beckmann(ndf) => widths(specular_part(&ndf, &case.material, 0, wi).unwrap()),
+                                AnyNdf::StudentT(ndf) => widths(specular_part(&ndf, &case.material, 0, wi).unwrap()),
                             };
                             for (axis, ratio) in [("cos", peak.scale.0 / u), ("phi", peak.scale.1 / phi)] {
                                 println!("{ndf} {alpha} {material:?} {theta} {h:?} {axis}: {ratio:.3}");
