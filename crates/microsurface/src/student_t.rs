@@ -10,7 +10,7 @@ use rand::Rng;
 use rand_distr::{Distribution, Gamma};
 
 use crate::beta::{ln_beta, regularized_incomplete_beta};
-use crate::ndf::{Ndf, Roughness, SQRT_PI, slope_to_normal, std_beckmann_slope};
+use crate::ndf::{Ndf, Roughness, SQRT_PI, std_beckmann_slope};
 use crate::random::{exp1, open01};
 
 /// Anisotropic Student-T with roughness (alpha_x, alpha_y) and shape `gamma > 3/2` (§1.6).
@@ -141,14 +141,19 @@ impl StudentT {
         // Below the horizon, t = -x > a = -mu: the proposal t e^{-t^2/s^2} on t > a has mass
         // s e^{-a^2/s^2} / (2 sqrt(pi)) given G, so G is drawn from the mixing law weighted by
         // it, Gamma(gamma - 3/2, 1 + a^2 / (gamma-1)); then t = sqrt(a^2 + s^2 E), kept with
-        // (t - a) / t.
+        // (t - a) / t. Written in a_G^2 = a^2 / s^2 = g k, with g the Gamma(gamma - 3/2, 1)
+        // draw and k = a^2 / (gamma - 1 + a^2), so that nothing squares `a`: near the nadir
+        // `a` reaches 1e154 and more, where a^2 overflows (the rate was then infinite and no
+        // draw was ever kept).
         let a = -mu;
-        let rate = 1.0 + a * a / (self.gamma - 1.0);
+        let inv = 1.0 / a;
+        let k = 1.0 / (1.0 + (self.gamma - 1.0) * inv * inv);
         loop {
-            let s = scale(self.scaled_mixing.sample(rng) / rate);
-            let t = (a * a + s * s * exp1(rng)).sqrt();
-            if open01(rng) * t < t - a {
-                return (-t, s);
+            let a_g = (self.scaled_mixing.sample(rng) * k).sqrt();
+            let stretch = (1.0 + exp1(rng) / (a_g * a_g)).sqrt();
+            // (t - a) / t = 1 - 1 / stretch with t = a stretch.
+            if open01(rng) * stretch < stretch - 1.0 {
+                return (-a * stretch, a / a_g);
             }
         }
     }
@@ -211,9 +216,12 @@ impl Ndf for StudentT {
         };
         let (x, s) = self.visible_slope(mu, rng);
         let y = s * std_beckmann_slope(rng);
+        // Slopes near the nadir reach 1e154 and more: scaled before squaring (normalize).
+        let c = x.abs().max(y.abs()).max(1.0);
+        let (x, y) = (x / c, y / c);
         let sx = cos_phi * x - sin_phi * y;
         let sy = sin_phi * x + cos_phi * y;
-        slope_to_normal(self.roughness.x * sx, self.roughness.y * sy)
+        DVec3::new(-self.roughness.x * sx, -self.roughness.y * sy, 1.0 / c).normalize()
     }
 
     /// The slope radius of `D(m) m_z` has `P(r' > r) = (1 + r^2/(gamma-1))^{-(gamma-1)}`, so
