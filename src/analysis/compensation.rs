@@ -543,6 +543,7 @@ impl AlbedoCache {
                     (Some(table), _) if f == Fresnel::One => Albedo::from_table(table, ndf.roughness().x),
                     (_, AnyNdf::Ggx(ndf)) => Albedo::exact(&ndf, f),
                     (_, AnyNdf::Beckmann(ndf)) => Albedo::exact(&ndf, f),
+                    (_, AnyNdf::StudentT(_)) => unreachable!("compensation::applies refuses Student-T"),
                 };
                 self.entries.push((key, albedo));
                 self.entries.len() - 1
@@ -552,8 +553,9 @@ impl AlbedoCache {
     }
 }
 
-/// Whether a case is one the compensation models describe: a conductor on an isotropic
-/// surface with the true Smith Lambda and visible normals, lit from outside.
+/// Whether a case is one the compensation models describe: a conductor on an isotropic GGX or
+/// Beckmann surface with the true Smith Lambda and visible normals, lit from outside (their
+/// albedo tables and tests do not cover Student-T).
 pub fn applies(case: &Case) -> bool {
     unavailable(case).is_none()
 }
@@ -563,6 +565,8 @@ fn unavailable(case: &Case) -> Option<&'static str> {
     let Roughness { x, y } = case.roughness();
     if !matches!(case.material, Material::Conductor(_)) {
         Some("not a conductor")
+    } else if matches!(case.surface.ndf, AnyNdf::StudentT(_)) {
+        Some("a Student-T NDF (the exact albedo quadrature is of GGX and Beckmann)")
     } else if x != y {
         Some("anisotropic")
     } else if case.surface.smith != Smith::Exact || case.surface.normals != Normals::Visible {
@@ -582,7 +586,7 @@ pub fn materialx_unavailable(case: &Case) -> Option<&'static str> {
     unavailable(case).or_else(|| match case.surface.ndf {
         AnyNdf::Ggx(_) if case.roughness().x > 1.0 => Some("alpha > 1 (MaterialX clamps alpha to 1)"),
         AnyNdf::Ggx(_) => None,
-        AnyNdf::Beckmann(_) => Some("not GGX"),
+        AnyNdf::Beckmann(_) | AnyNdf::StudentT(_) => Some("not GGX"),
     })
 }
 
@@ -631,6 +635,7 @@ pub fn compensated_bins<const C: usize>(
                 let lobe = Compensated::new(model, ndf, f, &albedo, &albedo_fresnel);
                 integrate_bins(case, grid, Hemisphere::R, rule, |wo| lobe.bsdf(wi, wo) * wo.z)
             }
+            AnyNdf::StudentT(_) => unreachable!("compensation::applies refuses Student-T"),
         };
         done.push((f, lobe.clone()));
         lobe

@@ -200,9 +200,13 @@ pub fn single_scattering_bins(
 }
 
 /// Why single scattering is not available for `case` (the symmetric Smith Lambda, Hammon's
-/// normals, light from inside), or `None` where it is.
+/// normals, light from inside, the Student-T NDF), or `None` where it is.
 pub fn single_scattering_unavailable(case: &Case) -> Option<&'static str> {
-    if case.surface.smith != Smith::Exact {
+    if matches!(case.surface.ndf, AnyNdf::StudentT(_)) {
+        // The walk's order-1 oracle (microsurface::single) takes any NDF and is tested against
+        // Student-T walks there; this model's bin rules are written for GGX and Beckmann.
+        Some("Student-T NDF (no quadrature rule for its visible normals here)")
+    } else if case.surface.smith != Smith::Exact {
         Some("symmetric Smith Lambda")
     } else if case.surface.normals != Normals::Visible {
         Some("Hammon's rejection normals")
@@ -225,10 +229,11 @@ pub fn single_scattering_lobe(
     if single_scattering_unavailable(case).is_some() {
         return None;
     }
-    Some(match case.surface.ndf {
-        AnyNdf::Ggx(ndf) => bins_for(&ndf, case, grid, (hemisphere, channel), tolerance),
-        AnyNdf::Beckmann(ndf) => bins_for(&ndf, case, grid, (hemisphere, channel), tolerance),
-    })
+    match case.surface.ndf {
+        AnyNdf::Ggx(ndf) => Some(bins_for(&ndf, case, grid, (hemisphere, channel), tolerance)),
+        AnyNdf::Beckmann(ndf) => Some(bins_for(&ndf, case, grid, (hemisphere, channel), tolerance)),
+        AnyNdf::StudentT(_) => None,
+    }
 }
 
 /// The order-1 lobe of `case` in every bin of `hemisphere`, colour channel `channel`: the sum
@@ -250,6 +255,7 @@ fn bins_for<N: Ndf>(
     let visible = || match case.surface.ndf {
         AnyNdf::Ggx(ndf) => ggx_visible_rule(&ndf, wi),
         AnyNdf::Beckmann(ndf) => beckmann_visible_rule(&ndf, wi),
+        AnyNdf::StudentT(_) => unreachable!("single_scattering_unavailable refuses Student-T"),
     };
     let parts: Vec<_> = [
         specular_part(ndf, &case.material, channel, wi)
@@ -497,6 +503,7 @@ mod tests {
                             let (u, phi) = match case.surface.ndf {
                                 AnyNdf::Ggx(ndf) => widths(specular_part(&ndf, &case.material, 0, wi).unwrap()),
                                 AnyNdf::Beckmann(ndf) => widths(specular_part(&ndf, &case.material, 0, wi).unwrap()),
+                                AnyNdf::StudentT(ndf) => widths(specular_part(&ndf, &case.material, 0, wi).unwrap()),
                             };
                             for (axis, ratio) in [("cos", peak.scale.0 / u), ("phi", peak.scale.1 / phi)] {
                                 println!("{ndf} {alpha} {material:?} {theta} {h:?} {axis}: {ratio:.3}");

@@ -13,7 +13,7 @@ use crate::engine::simulate;
 use crate::setup::config::{Config, EnergyConfig, parse_toml};
 
 /// The reference cases: (label, `[surface]` and `[material]` TOML, theta_i in degrees).
-pub const CASES: [(&str, &str, f64); 5] = [
+pub const CASES: [(&str, &str, f64); 7] = [
     ("ggx conductor F=1 a=0.5 60deg", "ndf = \"ggx\"\nalpha = 0.5\n[material]\nkind = \"conductor\"", 60.0),
     ("ggx conductor F=1 a=1 0deg", "ndf = \"ggx\"\nalpha = 1.0\n[material]\nkind = \"conductor\"", 0.0),
     (
@@ -23,6 +23,16 @@ pub const CASES: [(&str, &str, f64); 5] = [
     ),
     ("ggx diffuse a=1 0deg", "ndf = \"ggx\"\nalpha = 1.0\n[material]\nkind = \"diffuse\"", 0.0),
     ("beckmann conductor F=1 a=0.5 60deg", "ndf = \"beckmann\"\nalpha = 0.5\n[material]\nkind = \"conductor\"", 60.0),
+    (
+        "student-t 3 conductor F=1 a=0.5 60deg",
+        "ndf = \"student-t\"\ngamma = 3\nalpha = 0.5\n[material]\nkind = \"conductor\"",
+        60.0,
+    ),
+    (
+        "student-t 1.6 conductor F=1 a=0.5 60deg",
+        "ndf = \"student-t\"\ngamma = 1.6\nalpha = 0.5\n[material]\nkind = \"conductor\"",
+        60.0,
+    ),
 ];
 
 /// The run configuration of a reference case with `paths` photons and the default detector;

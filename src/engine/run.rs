@@ -15,6 +15,7 @@ use microsurface::material::Material;
 use microsurface::ndf::{AnyNdf, Beckmann, Ggx, Ndf};
 use microsurface::nee::NextEvent;
 use microsurface::position_free::DepthProfile;
+use microsurface::student_t::StudentT;
 use microsurface::walk::{EnergyPolicy, Microsurface, Observer};
 use microsurface::wang::Shadowing;
 use rand_pcg::Pcg64Mcg;
@@ -430,6 +431,9 @@ where
         AnyNdf::Ggx(ndf) => with_material::<Ggx, C, T>(Microsurface { ndf, smith, normals }, case, settings, f),
         AnyNdf::Beckmann(ndf) => {
             with_material::<Beckmann, C, T>(Microsurface { ndf, smith, normals }, case, settings, f)
+        }
+        AnyNdf::StudentT(ndf) => {
+            with_material::<StudentT, C, T>(Microsurface { ndf, smith, normals }, case, settings, f)
         }
     }
 }

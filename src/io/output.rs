@@ -28,6 +28,7 @@ pub(crate) fn case_fields(case: &Case) -> Vec<String> {
         case.surface.ndf.name().to_string(),
         case.roughness().x.to_string(),
         case.roughness().y.to_string(),
+        case.gamma().map_or(String::new(), |g| g.to_string()),
         name(&case.height),
         case.surface.smith.name().to_string(),
         case.surface.normals.name().to_string(),
@@ -344,6 +345,9 @@ struct CaseReport<'a> {
     ndf: &'static str,
     alpha_x: f64,
     alpha_y: f64,
+    /// The Student-T shape; absent for the other NDFs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gamma: Option<f64>,
     height: HeightKind,
     smith: &'static str,
     normals: &'static str,
@@ -362,6 +366,7 @@ impl<'a> CaseReport<'a> {
             ndf: case.surface.ndf.name(),
             alpha_x: x,
             alpha_y: y,
+            gamma: case.gamma(),
             height: case.height,
             smith: case.surface.smith.name(),
             normals: case.surface.normals.name(),

@@ -26,9 +26,10 @@ const fn column(name: &'static str, unit: &'static str, meaning: &'static str) -
 
 // The columns that identify a case, in the order every table that names cases writes them.
 pub const CASE: Column = column("case", "", "case index, in the order the config's sweep expands");
-pub const NDF: Column = column("ndf", "", "normal distribution: ggx or beckmann");
+pub const NDF: Column = column("ndf", "", "normal distribution: ggx, beckmann or student-t");
 pub const ALPHA_X: Column = column("alpha_x", "", "roughness along x (slope standard deviation / sqrt 2)");
 pub const ALPHA_Y: Column = column("alpha_y", "", "roughness along y");
+pub const GAMMA: Column = column("gamma", "", "Student-T shape gamma (empty for ggx and beckmann)");
 pub const HEIGHT: Column = column("height", "", "height distribution of the microsurface: uniform or gaussian");
 pub const SMITH: Column = column("smith", "", "masking function: exact, or an approximation");
 pub const NORMALS: Column = column("normals", "", "facet normal sampling: visible, or an alternative");
@@ -43,8 +44,8 @@ pub const PHI_I_DEG: Column = column(
 pub const SIDE: Column = column("side", "", "the side the light comes from: outside or inside");
 
 /// The leading columns of `lobes.csv`, `summary.csv` and `compare.csv`.
-pub const CASE_COLUMNS: [Column; 11] =
-    [CASE, NDF, ALPHA_X, ALPHA_Y, HEIGHT, SMITH, NORMALS, MATERIAL, THETA_I_DEG, PHI_I_DEG, SIDE];
+pub const CASE_COLUMNS: [Column; 12] =
+    [CASE, NDF, ALPHA_X, ALPHA_Y, GAMMA, HEIGHT, SMITH, NORMALS, MATERIAL, THETA_I_DEG, PHI_I_DEG, SIDE];
 
 // A lobe and a bin.
 pub const ORDER: Column = column("order", "", "order slot: 0 all orders, k >= 1 order k (the folded slot K is K+)");
@@ -125,7 +126,7 @@ pub struct TableSchema {
     pub columns: &'static [Column],
 }
 
-const LOBES_COLUMNS: [Column; 26] = concat(
+const LOBES_COLUMNS: [Column; 27] = concat(
     &CASE_COLUMNS,
     &[
         ORDER,
@@ -146,10 +147,10 @@ const LOBES_COLUMNS: [Column; 26] = concat(
     ],
 );
 
-const SUMMARY_COLUMNS: [Column; 19] =
+const SUMMARY_COLUMNS: [Column; 20] =
     concat(&CASE_COLUMNS, &[PATHS, ORDER, SUMMARY_ROW, CHANNEL, ALBEDO, ALBEDO_STDERR, ALBEDO_VOV, FOLDED]);
 
-const COMPARE_COLUMNS: [Column; 29] = concat(
+const COMPARE_COLUMNS: [Column; 30] = concat(
     &CASE_COLUMNS,
     &[
         MODEL,

@@ -44,6 +44,14 @@ impl Case {
         self.surface.ndf.roughness()
     }
 
+    /// The shape of a Student-T NDF (theory §1.6); `None` for the others.
+    pub fn gamma(&self) -> Option<f64> {
+        match self.surface.ndf {
+            AnyNdf::StudentT(ndf) => Some(ndf.gamma()),
+            _ => None,
+        }
+    }
+
     /// Whether the exact position-free form (docs/theory.md §7.1) describes this case's walk: facets
     /// that reflect on one side, the true Smith Lambda and visible normals (the chain's laws).
     pub fn position_free_applies(&self) -> bool {
@@ -70,7 +78,7 @@ pub fn expand(config: &Config) -> Result<Vec<Case>, ConfigError> {
         .map(|(field, m)| Ok((physics::material(&field, m)?, m.clone())))
         .collect::<Result<Vec<_>, ConfigError>>()?;
     let product = iproduct!(
-        s.ndf.values(),
+        s.ndf_shapes(),
         roughnesses,
         s.height.values(),
         s.smith.values(),
@@ -81,15 +89,18 @@ pub fn expand(config: &Config) -> Result<Vec<Case>, ConfigError> {
         i.phi_deg.values()
     );
     let cases = product.enumerate().map(
-        |(index, (ndf, roughness, height, smith, normals, (material, material_spec), side, theta_i_deg, phi_i_deg))| {
+        |(
+            index,
+            ((ndf, gamma), roughness, height, smith, normals, (material, material_spec), side, theta_i_deg, phi_i_deg),
+        )| {
             let surface = Microsurface {
-                ndf: physics::ndf(ndf, roughness),
+                ndf: physics::ndf(ndf, roughness, gamma)?,
                 smith: physics::smith(smith),
                 normals: physics::normals(normals),
             };
             let wi = physics::incident_direction(theta_i_deg, phi_i_deg, side);
-            Case { index, surface, height, material, material_spec, theta_i_deg, phi_i_deg, side, wi }
+            Ok(Case { index, surface, height, material, material_spec, theta_i_deg, phi_i_deg, side, wi })
         },
     );
-    Ok(cases.collect())
+    cases.collect()
 }

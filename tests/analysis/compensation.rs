@@ -69,6 +69,7 @@ fn e_direct(ndf: NdfKind, alpha: f64, mu: f64, f: Fresnel) -> f64 {
     match ndf {
         NdfKind::Ggx => directional_albedo(&Ggx::with_alpha(alpha), mu, f, TOL),
         NdfKind::Beckmann => directional_albedo(&Beckmann::with_alpha(alpha), mu, f, TOL),
+        NdfKind::StudentT => panic!("the compensation models cover GGX and Beckmann only"),
     }
 }
 
@@ -76,6 +77,7 @@ fn e_table(ndf: NdfKind, alpha: f64, f: Fresnel) -> Albedo {
     match ndf {
         NdfKind::Ggx => Albedo::exact(&Ggx::with_alpha(alpha), f),
         NdfKind::Beckmann => Albedo::exact(&Beckmann::with_alpha(alpha), f),
+        NdfKind::StudentT => panic!("the compensation models cover GGX and Beckmann only"),
     }
 }
 

@@ -25,7 +25,7 @@ fn every_bad_config_names_its_field_value_and_what_is_allowed() {
     let cases = [
         (
             with("alpha = 0.5", "alpha = 0.5\nndf = \"gaussian\""),
-            ["`surface.ndf` = \"gaussian\"", "\"ggx\" or \"beckmann\""],
+            ["`surface.ndf` = \"gaussian\"", "\"beckmann\" or \"student-t\""],
         ),
         (with("\"conductor\"", "\"metal\""), ["`material.kind` = \"metal\"", "\"dielectric\""]),
         (with("theta_deg = 30", "theta_deg = 30\nside = \"bottom\""), ["`incident.side` = \"bottom\"", "\"inside\""]),
@@ -408,4 +408,32 @@ fn compare_paths_beyond_the_run_limit_are_refused() {
     assert_eq!(out.status.code(), Some(1), "{e}");
     assert!(e.contains("`--paths` = 1000000000000001 is not allowed") && e.contains("10^15"), "{e}");
     assert!(!run_dir.join("models.csv").exists());
+}
+
+/// `gamma` is the shape of `ndf = "student-t"`, finite and > 1.5, and of no other NDF: each bad
+/// combination is refused in one line naming the field, the value and what is allowed, with
+/// no output directory.
+#[test]
+fn student_t_shapes_are_checked_before_any_work() {
+    let st = |gamma: &str| BASE.replace("alpha = 0.5", &format!("alpha = 0.5\nndf = \"student-t\"\n{gamma}"));
+    let cases = [
+        (st("gamma = 1.5"), vec!["`surface.gamma` = 1.5", "finite and > 1.5"]),
+        (st("gamma = [3, -2]"), vec!["`surface.gamma` = -2", "finite and > 1.5"]),
+        (st("gamma = inf"), vec!["`surface.gamma` = inf", "finite and > 1.5"]),
+        (st("gamma = nan"), vec!["`surface.gamma` = NaN", "finite and > 1.5"]),
+        (st("gamma = []"), vec!["surface.gamma"]),
+        (st(""), vec!["surface.gamma", "finite and > 1.5"]),
+        (
+            BASE.replace("alpha = 0.5", "alpha = 0.5\ngamma = 3"),
+            vec!["`surface.gamma` = 3", "only with ndf = \"student-t\""],
+        ),
+    ];
+    for (config, parts) in cases {
+        let (code, e) = run(&config, &[]);
+        assert_eq!(code, Some(1), "{config}: {e}");
+        for part in parts {
+            assert!(e.contains(part), "{e:?} lacks {part:?}");
+        }
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
 }

@@ -191,3 +191,42 @@ fn a_directory_in_use_is_refused_and_a_run_clears_leftovers() {
     let _held = lock_dir(&out, true).unwrap();
     assert!(open_error(&out).contains("being written by a smithwalk run"));
 }
+
+/// `ndf = "student-t"` end to end: `gamma` is a sweep axis next to `alpha` (a GGX case and two
+/// Student-T shapes make three cases), each case's shape is in `summary.csv`'s `gamma` column
+/// (empty for GGX) and in `run.json`, the tables open as a run directory, and every case has
+/// its R and T rows (the furnace tests of Student-T walks are in the physics crate's
+/// walk_lobes.rs).
+#[test]
+fn a_student_t_sweep_runs_end_to_end_and_records_its_shapes() {
+    let dir = tempfile::tempdir().unwrap();
+    let toml = MONO.replace("alpha = 0.5", "alpha = 0.5\nndf = [\"ggx\", \"student-t\"]\ngamma = [1.6, 10]");
+    write_run(&toml, dir.path());
+    RunDir::open(dir.path()).unwrap();
+    let summary = std::fs::read_to_string(dir.path().join("summary.csv")).unwrap();
+    let mut lines = summary.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (ndf, gamma, row, albedo) = (column("ndf"), column("gamma"), column("hemisphere"), column("albedo"));
+    let mut shapes = std::collections::BTreeSet::new();
+    let mut totals = std::collections::BTreeMap::<String, f64>::new();
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        shapes.insert((cells[ndf].to_string(), cells[gamma].to_string()));
+        if cells[column("order")] == "0" && ["R", "T"].contains(&cells[row]) {
+            *totals.entry(format!("{} {}", cells[0], cells[column("theta_i_deg")])).or_default() +=
+                cells[albedo].parse::<f64>().unwrap();
+        }
+    }
+    let expected: std::collections::BTreeSet<_> =
+        [("ggx", ""), ("student-t", "1.6"), ("student-t", "10")].map(|(a, b)| (a.to_string(), b.to_string())).into();
+    assert_eq!(shapes, expected);
+    assert_eq!(totals.len(), 6, "{totals:?}");
+    for (case, total) in totals {
+        assert!(total.is_finite() && total > 0.5, "case {case}: R + T = {total}");
+    }
+    let run: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("run.json")).unwrap()).unwrap();
+    let gammas: Vec<Option<f64>> = run["cases"].as_array().unwrap().iter().map(|c| c["gamma"].as_f64()).collect();
+    assert_eq!(gammas, [None, None, Some(1.6), Some(1.6), Some(10.0), Some(10.0)]);
+}

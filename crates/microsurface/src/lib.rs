@@ -6,6 +6,8 @@
 //!
 //! * [`ndf`]: the distribution of normals (GGX, Beckmann), its Smith `Lambda`, projected area
 //!   and exact full-sphere visible-normal sampling;
+//! * [`student_t`]: the Student-T NDF, between GGX and Beckmann, with its exact `Lambda` and
+//!   visible-normal sampler;
 //! * [`smith`]: which `Lambda` drives the height process (true full-sphere Smith or Hammon's
 //!   symmetric variant);
 //! * [`height`]: the height process as free flights in optical depth;
@@ -35,7 +37,7 @@
 //! users are meant to build on are:
 //!
 //! * the surface: [`ndf::Ndf`] (the trait every NDF implements), [`ndf::Ggx`],
-//!   [`ndf::Beckmann`], [`ndf::Roughness`], and [`ndf::AnyNdf`] (an NDF chosen at run time);
+//!   [`ndf::Beckmann`], [`student_t::StudentT`], [`ndf::Roughness`], and [`ndf::AnyNdf`] (an NDF chosen at run time);
 //!   [`smith::Smith`], [`normals::Normals`], and [`walk::Microsurface`], which composes them;
 //! * the facets: [`facet::Facet`] (the trait every micro-BSDF implements), [`facet::Conductor`]
 //!   with its [`facet::ConductorFresnel`], [`facet::Dielectric`], [`facet::Lambertian`],
@@ -67,6 +69,7 @@ pub mod roots;
 pub mod single;
 pub mod slope;
 pub mod smith;
+pub mod student_t;
 pub mod walk;
 pub mod wang;
 

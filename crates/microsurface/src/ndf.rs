@@ -12,8 +12,9 @@ use rand::Rng;
 use statrs::function::erf::erfc;
 
 use crate::random::{azimuth, exp1, normal1, open01};
+use crate::student_t::StudentT;
 
-const SQRT_PI: f64 = 1.772_453_850_905_516;
+pub(crate) const SQRT_PI: f64 = 1.772_453_850_905_516;
 
 /// Anisotropic roughness: the slope scales along the tangent axes x and y (§0, §1.2).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,7 +33,7 @@ impl Roughness {
 
     /// `alpha_x^2 w_x^2 + alpha_y^2 w_y^2`: the squared projected roughness times `1 - w_z^2` (§1.3).
     #[inline]
-    fn tangential2(self, w: DVec3) -> f64 {
+    pub(crate) fn tangential2(self, w: DVec3) -> f64 {
         let (ax, ay) = (self.x * w.x, self.y * w.y);
         ax * ax + ay * ay
     }
@@ -52,7 +53,8 @@ impl Roughness {
     }
 }
 
-/// A microfacet normal distribution (§1.2): the alternatives are GGX and Beckmann.
+/// A microfacet normal distribution (§1.2): the alternatives are GGX, Beckmann and Student-T
+/// (§1.6, [`crate::student_t`]).
 pub trait Ndf: Copy + Send + Sync {
     /// The roughness (alpha_x, alpha_y) that stretches the roughness-1 configuration (§1.1).
     fn roughness(&self) -> Roughness;
@@ -269,6 +271,8 @@ pub enum AnyNdf {
     Ggx(Ggx),
     /// Beckmann.
     Beckmann(Beckmann),
+    /// Student-T (§1.6), between the two.
+    StudentT(StudentT),
 }
 
 impl AnyNdf {
@@ -277,6 +281,7 @@ impl AnyNdf {
         match self {
             AnyNdf::Ggx(_) => "ggx",
             AnyNdf::Beckmann(_) => "beckmann",
+            AnyNdf::StudentT(_) => "student-t",
         }
     }
 }
@@ -287,6 +292,7 @@ macro_rules! dispatch {
         match $any {
             AnyNdf::Ggx($n) => $body,
             AnyNdf::Beckmann($n) => $body,
+            AnyNdf::StudentT($n) => $body,
         }
     };
 }
@@ -334,7 +340,7 @@ pub fn slope_to_normal(x: f64, y: f64) -> DVec3 {
 /// One slope coordinate of the roughness-1 Beckmann distribution, density `e^{-x^2} / sqrt(pi)`:
 /// a normal of variance 1/2.
 #[inline]
-fn std_beckmann_slope<R: Rng + ?Sized>(rng: &mut R) -> f64 {
+pub(crate) fn std_beckmann_slope<R: Rng + ?Sized>(rng: &mut R) -> f64 {
     normal1(rng) * FRAC_1_SQRT_2
 }
 

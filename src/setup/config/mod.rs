@@ -28,6 +28,7 @@ pub(crate) use error::invalid;
 use error::missing;
 pub use incident::{IncidentConfig, IncidentSide};
 pub use material::{FresnelKind, MaterialConfig};
+use microsurface::ndf::Roughness;
 pub use physics::MAX_ALPHA;
 pub use precision::PrecisionConfig;
 pub use reading::{RUN_TABLES, Supplied, locate, parse_toml, parse_toml_supplied, shorten};
@@ -130,6 +131,21 @@ impl Config {
         non_empty("surface.alpha", &s.alpha)?;
         for alpha in s.alpha.values() {
             physics::roughness(alpha)?;
+        }
+        // `gamma` is the shape of `student-t` and of nothing else: physics::ndf says which
+        // combination is wrong, with `gamma` against the first NDF it does not fit.
+        let student_t = s.ndf.values().contains(&NdfKind::StudentT);
+        let unit = Roughness::isotropic(1.0);
+        match &s.gamma {
+            None if student_t => drop(physics::ndf(NdfKind::StudentT, unit, None)?),
+            None => {}
+            Some(gamma) => {
+                non_empty("surface.gamma", gamma)?;
+                let kind = if student_t { NdfKind::StudentT } else { s.ndf.values()[0] };
+                for g in gamma.values() {
+                    physics::ndf(kind, unit, Some(g))?;
+                }
+            }
         }
         let cases = self.cases();
         if cases > MAX_CASES {
@@ -262,7 +278,7 @@ impl Config {
         let i = &self.incident;
         let thetas = i.theta_deg.as_ref().or(i.theta_rad.as_ref()).map_or(0, |t| t.as_slice().len());
         [
-            s.ndf.as_slice().len(),
+            s.ndf_shapes().len(),
             s.alpha.as_slice().len(),
             s.height.as_slice().len(),
             s.smith.as_slice().len(),

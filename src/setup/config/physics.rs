@@ -16,6 +16,7 @@ use microsurface::material::Material;
 use microsurface::ndf::{AnyNdf, Beckmann, Ggx, Roughness};
 use microsurface::normals::Normals;
 use microsurface::smith::Smith;
+use microsurface::student_t::StudentT;
 
 use super::error::{ConfigError, invalid, missing};
 use super::incident::IncidentSide;
@@ -46,11 +47,23 @@ pub fn roughness(alpha: Alpha) -> Result<Roughness, ConfigError> {
     Ok(Roughness { x, y })
 }
 
-/// The NDF `kind` with roughness `roughness` (§1.2).
-pub fn ndf(kind: NdfKind, roughness: Roughness) -> AnyNdf {
-    match kind {
-        NdfKind::Ggx => AnyNdf::Ggx(Ggx(roughness)),
-        NdfKind::Beckmann => AnyNdf::Beckmann(Beckmann(roughness)),
+/// What a `gamma` entry must be.
+const GAMMA_ALLOWED: &str = "a Student-T shape, finite and > 1.5 (at 1.5 and below the mean slope is infinite and \
+                             Lambda does not exist; 2 is GGX, large values tend to Beckmann)";
+
+/// The NDF `kind` with roughness `roughness` (§1.2) and, for `student-t`, the shape `gamma`
+/// (§1.6): finite and > 1.5, given for `student-t` and only for it.
+pub fn ndf(kind: NdfKind, roughness: Roughness, gamma: Option<f64>) -> Result<AnyNdf, ConfigError> {
+    match (kind, gamma) {
+        (NdfKind::Ggx, None) => Ok(AnyNdf::Ggx(Ggx(roughness))),
+        (NdfKind::Beckmann, None) => Ok(AnyNdf::Beckmann(Beckmann(roughness))),
+        (NdfKind::StudentT, Some(g)) => {
+            StudentT::new(roughness, g).map(AnyNdf::StudentT).ok_or_else(|| invalid("surface.gamma", g, GAMMA_ALLOWED))
+        }
+        (NdfKind::StudentT, None) => Err(missing("surface.gamma", GAMMA_ALLOWED)),
+        (_, Some(g)) => {
+            Err(invalid("surface.gamma", g, "only with ndf = \"student-t\": GGX and Beckmann have no shape"))
+        }
     }
 }
 

@@ -217,6 +217,7 @@ pub(super) fn allowed_value(key: &str) -> Option<String> {
         "incident" => "a table with `theta_deg` or `theta_rad`, the incident polar angles".into(),
         "detector" | "energy" | "precision" | "compare" => format!("a table, [{key}] and its keys (README.md)"),
         "surface.alpha" => "a roughness > 0 and at most 1e4, a list of them (a sweep) or [[alpha_x, alpha_y]]".into(),
+        "surface.gamma" => "the Student-T shape (ndf = \"student-t\" only), a number > 1.5 or a list of them".into(),
         "material.kind" => kinds.into(),
         "material.name" => "a label, a string of at most 100 characters".into(),
         "incident.theta_deg" => {

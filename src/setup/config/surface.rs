@@ -10,6 +10,8 @@ use super::values::{Alpha, OneOrMany, deserialize_by_name};
 pub enum NdfKind {
     Ggx,
     Beckmann,
+    #[serde(rename = "student-t")]
+    StudentT,
 }
 
 #[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
@@ -33,7 +35,7 @@ pub enum NormalsKind {
     HammonRejection,
 }
 
-deserialize_by_name!(NdfKind: [NdfKind::Ggx, NdfKind::Beckmann]);
+deserialize_by_name!(NdfKind: [NdfKind::Ggx, NdfKind::Beckmann, NdfKind::StudentT]);
 deserialize_by_name!(HeightKind: [HeightKind::Uniform, HeightKind::Gaussian]);
 deserialize_by_name!(SmithKind: [SmithKind::Exact, SmithKind::Symmetric]);
 deserialize_by_name!(NormalsKind: [NormalsKind::Vndf, NormalsKind::HammonRejection]);
@@ -44,6 +46,9 @@ pub struct SurfaceConfig {
     #[serde(default = "default_ndf")]
     pub ndf: OneOrMany<NdfKind>,
     pub alpha: OneOrMany<Alpha>,
+    /// The Student-T shapes (theory §1.6), a sweep axis of the `student-t` NDF only.
+    #[serde(default)]
+    pub gamma: Option<OneOrMany<f64>>,
     #[serde(default = "default_height")]
     pub height: OneOrMany<HeightKind>,
     #[serde(default = "default_smith")]
@@ -63,4 +68,20 @@ fn default_smith() -> OneOrMany<SmithKind> {
 }
 fn default_normals() -> OneOrMany<NormalsKind> {
     OneOrMany::One(NormalsKind::Vndf)
+}
+
+impl SurfaceConfig {
+    /// The NDF axis of the sweep: each NDF once, `student-t` once per `gamma` (the shape is
+    /// `None` for the others).
+    pub fn ndf_shapes(&self) -> Vec<(NdfKind, Option<f64>)> {
+        let gammas = self.gamma.as_ref().map(|g| g.values()).unwrap_or_default();
+        self.ndf
+            .values()
+            .into_iter()
+            .flat_map(|kind| match kind {
+                NdfKind::StudentT => gammas.iter().map(|&g| (kind, Some(g))).collect::<Vec<_>>(),
+                _ => vec![(kind, None)],
+            })
+            .collect()
+    }
 }
