@@ -8,7 +8,7 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::cases::{groups, pretty_fields};
+use super::cases::{case_column, groups, pretty_fields};
 use super::points::{Points, bar_top};
 use super::rows::{Row, all_orders_only, folded_note, open_row, row_label};
 use super::selection::Selection;
@@ -35,10 +35,10 @@ impl Sweep {
     }
 
     /// Which case columns (of `CASE_COLUMNS`) the sweep varies, besides the case index.
-    fn columns(self) -> &'static [usize] {
+    fn columns(self) -> Vec<usize> {
         match self {
-            Sweep::Theta => &[8],
-            Sweep::Alpha => &[2, 3],
+            Sweep::Theta => vec![case_column("theta_i_deg")],
+            Sweep::Alpha => vec![case_column("alpha_x"), case_column("alpha_y")],
         }
     }
 
@@ -110,14 +110,14 @@ impl<'a> AlbedoFigure<'a> {
         rows: &'a [Row],
     ) -> Option<Self> {
         let channel = selection.channel_name();
-        let groups = groups(run.cases.iter().filter(|c| sweep.takes(c)), sweep.columns());
+        let groups = groups(run.cases.iter().filter(|c| sweep.takes(c)), &sweep.columns());
         let mut group_of = vec![usize::MAX; run.cases.len()];
         for (g, cases) in groups.iter().enumerate() {
             for case in cases {
                 group_of[case.index] = g;
             }
         }
-        let mut skip = sweep.columns().to_vec();
+        let mut skip = sweep.columns();
         skip.push(0);
         let mut panels = Vec::new();
         for (g, cases) in groups.iter().enumerate() {

@@ -13,6 +13,12 @@ fn group_key(case: &Case, swept: &[usize]) -> Vec<String> {
     case_fields(case).into_iter().enumerate().filter(|(i, _)| *i != 0 && !swept.contains(i)).map(|(_, f)| f).collect()
 }
 
+/// The index in `CASE_COLUMNS` of the case column called `name`: figures name the columns
+/// they sweep, so that a column added to the schema does not shift them.
+pub(super) fn case_column(name: &str) -> usize {
+    CASE_COLUMNS.iter().position(|c| c.name == name).expect("a case column of the schema")
+}
+
 /// Cases that differ only in the columns `swept` (indices into `CASE_COLUMNS`), in order of
 /// their first case, each sorted by the incident angle.
 pub(super) fn groups<'a>(cases: impl IntoIterator<Item = &'a Case>, swept: &[usize]) -> Vec<Vec<&'a Case>> {
@@ -82,11 +88,12 @@ pub(super) fn pretty_fields(run: &RunDir, case: &Case, skip: &[usize]) -> String
 /// How the case columns `columns` of a case (its `fields`) read in captions, an isotropic
 /// roughness as one value.
 pub(super) fn describe(fields: &[String], columns: &[usize]) -> Vec<String> {
-    let isotropic = columns.contains(&2) && columns.contains(&3) && fields[2] == fields[3];
+    let (x, y) = (case_column("alpha_x"), case_column("alpha_y"));
+    let isotropic = columns.contains(&x) && columns.contains(&y) && fields[x] == fields[y];
     columns
         .iter()
-        .filter(|&&c| !(isotropic && c == 3))
-        .map(|&c| if isotropic && c == 2 { format!("α = {}", fields[2]) } else { pretty_field(c, &fields[c]) })
+        .filter(|&&c| !(isotropic && c == y))
+        .map(|&c| if isotropic && c == x { format!("α = {}", fields[x]) } else { pretty_field(c, &fields[c]) })
         .collect()
 }
 
@@ -100,14 +107,20 @@ pub(super) fn surface_label(run: &RunDir, case: &Case) -> String {
         format!("α = ({}, {})", case.roughness().x, case.roughness().y)
     };
     let fields = case_fields(case);
-    let mut label = format!("{}, {alpha}, {}", ndf_label(&fields[1]), fields[7]);
-    for (column, default) in [(5, "exact"), (6, "vndf")] {
-        if fields[column] != default {
-            label.push_str(&format!(", {} {}", CASE_COLUMNS[column].name, fields[column]));
+    let field = |name: &str| &fields[case_column(name)];
+    let mut label = format!("{}, {alpha}", ndf_label(field("ndf")));
+    if !field("gamma").is_empty() {
+        label.push_str(&format!(", γ = {}", field("gamma")));
+    }
+    label.push_str(&format!(", {}", field("material")));
+    for (name, default) in [("smith", "exact"), ("normals", "vndf")] {
+        if field(name) != default {
+            label.push_str(&format!(", {name} {}", field(name)));
         }
     }
-    if fields[10] != "outside" || varying(&run.cases).contains(&10) {
-        label.push_str(&format!(", {}", pretty_field(10, &fields[10])));
+    let side = case_column("side");
+    if fields[side] != "outside" || varying(&run.cases).contains(&side) {
+        label.push_str(&format!(", {}", pretty_field(side, &fields[side])));
     }
     label
 }

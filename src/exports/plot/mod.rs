@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 
-use self::cases::groups;
+use self::cases::{case_column, groups};
 use self::report::Drawn;
 use self::rows::rows;
 use self::selection::Selection;
@@ -84,7 +84,7 @@ pub fn plot(run_dir: &Path, options: &PlotOptions) -> Result<Vec<PathBuf>> {
         }
     }
     let mut sections = Vec::new();
-    for (g, cases) in groups(&run.cases, &[8]).into_iter().enumerate() {
+    for (g, cases) in groups(&run.cases, &[case_column("theta_i_deg")]).into_iter().enumerate() {
         let mut lobes = Vec::new();
         let mut heats = Vec::new();
         for hemisphere in crate::io::output::hemispheres(cases[0]).iter().map(|h| format!("{h:?}")) {
