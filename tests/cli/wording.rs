@@ -77,9 +77,9 @@ fn every_bad_config_names_its_field_value_allowed_values_line_and_column() {
             "`incident.phi_deg` = { from = 0, to = 90 } is not allowed (line 8, column 11): an azimuth in degrees".into()),
         // Names (unit enums): serde's "expected enum NdfKind", "unknown variant".
         (run, edit(RUN, &[("alpha = 0.5", "alpha = 0.5\nndf = 3")]),
-            "`surface.ndf` = 3 is not allowed (line 4, column 7): \"ggx\" or \"beckmann\"".into()),
+            "`surface.ndf` = 3 is not allowed (line 4, column 7): \"ggx\", \"beckmann\" or \"student-t\"".into()),
         (run, edit(RUN, &[("alpha = 0.5", "alpha = 0.5\nndf = [\"ggx\", 3]")]),
-            "`surface.ndf[1]` = 3 is not allowed (line 4, column 15): \"ggx\" or \"beckmann\"".into()),
+            "`surface.ndf[1]` = 3 is not allowed (line 4, column 15): \"ggx\", \"beckmann\" or \"student-t\"".into()),
         (run, edit(RUN, &[("alpha = 0.5", "alpha = 0.5\nsmith = { exact = 1 }")]),
             "`surface.smith` = { exact = 1 } is not allowed (line 4, column 9): \"exact\" or \"symmetric\"".into()),
         (run, edit(RUN, &[("theta_deg = 30", "theta_deg = 30\nside = 1")]),
@@ -143,7 +143,10 @@ fn a_bad_dict_gets_the_same_words_without_a_place() {
     let cases = [
         (("\"conductor\"", "\"glass\""), format!("`material.kind` = \"glass\" is not allowed: {kinds}")),
         (("alpha = 0.5", "alpha = {}"), "`surface.alpha` = {} is not allowed: a roughness > 0".to_string()),
-        (("alpha = 0.5", "alpha = 0.5\nndf = 3"), "`surface.ndf` = 3 is not allowed: \"ggx\" or \"beckmann\"".into()),
+        (
+            ("alpha = 0.5", "alpha = 0.5\nndf = 3"),
+            "`surface.ndf` = 3 is not allowed: \"ggx\", \"beckmann\" or \"student-t\"".into(),
+        ),
         (("alpha = 0.5", "alpha = -1"), "`surface.alpha` = -1 is not allowed: a roughness > 0".into()),
         (("kind = \"conductor\"", "fresnel = \"none\""), format!("`material.kind` is missing: {kinds}")),
     ];
