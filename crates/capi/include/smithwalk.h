@@ -79,7 +79,7 @@ extern "C" {
  * Names are NUL-terminated UTF-8 strings, read only during smithwalk_bsdf_new.
  */
 typedef struct smithwalk_params {
-    /* "ggx" or "beckmann". Default "ggx". */
+    /* "ggx", "beckmann" or "student-t". Default "ggx". */
     const char *ndf;
     /* "conductor", "dielectric", "lambertian" or "hammon". Default "conductor". */
     const char *material;
@@ -91,6 +91,9 @@ typedef struct smithwalk_params {
        surface. Default 0.5 and 0.5. */
     double alpha_u;
     double alpha_v;
+    /* The Student-T shape gamma (ndf "student-t"), finite and > 1.5: 2 is GGX, larger values
+       approach Beckmann. Ignored by the other NDFs. Default NaN (not set: "student-t" refuses it). */
+    double gamma;
     /* A conductor's real index per channel (fresnel "exact"), finite and > 0; a dielectric's
        relative index n_inside / n_outside in eta[0], finite and > 0. Default 1. */
     double eta[3];

@@ -50,7 +50,7 @@ pub struct SmithwalkBsdf(CBsdf);
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct SmithwalkParams {
-    /// `"ggx"` or `"beckmann"`.
+    /// `"ggx"`, `"beckmann"` or `"student-t"`.
     pub ndf: *const c_char,
     /// `"conductor"`, `"dielectric"`, `"lambertian"` or `"hammon"`.
     pub material: *const c_char,
@@ -60,6 +60,8 @@ pub struct SmithwalkParams {
     pub alpha_u: f64,
     /// Roughness along the tangent y axis, finite and > 0.
     pub alpha_v: f64,
+    /// The Student-T shape (`ndf` `"student-t"`), finite and > 1.5; ignored by the other NDFs.
+    pub gamma: f64,
     /// A conductor's real index per channel; a dielectric's `n_inside / n_outside` in `eta[0]`.
     pub eta: [f64; 3],
     /// A conductor's extinction coefficient per channel.
@@ -182,7 +184,7 @@ unsafe fn put<T>(out: *mut T, value: T) {
     }
 }
 
-/// The defaults of [`SmithwalkParams`]: GGX, alpha 0.5, a lossless conductor (`fresnel`
+/// The defaults of [`SmithwalkParams`]: GGX, alpha 0.5, gamma NaN (unset), a lossless conductor (`fresnel`
 /// `"none"`), `eta` 1, `k` 0, `f0` 1, `albedo` 1, every order. Writes nothing if `out` is NULL.
 ///
 /// # Safety
@@ -195,6 +197,7 @@ pub unsafe extern "C" fn smithwalk_params_default(out: *mut SmithwalkParams) {
         fresnel: c"none".as_ptr(),
         alpha_u: 0.5,
         alpha_v: 0.5,
+        gamma: f64::NAN,
         eta: [1.0; 3],
         k: [0.0; 3],
         f0: [1.0; 3],
@@ -224,6 +227,7 @@ pub unsafe extern "C" fn smithwalk_bsdf_new(params: *const SmithwalkParams, out:
         let description = Description {
             ndf: unsafe { name("ndf", p.ndf)? },
             alpha: Roughness { x: p.alpha_u, y: p.alpha_v },
+            gamma: p.gamma,
             material: unsafe { name("material", p.material)? },
             fresnel: unsafe { name("fresnel", p.fresnel)? },
             eta: p.eta,

@@ -12,7 +12,7 @@
 //! * [`Bsdf::pdf`] is a deterministic density for multiple-importance weights: a mixture of the
 //!   visible-normal density of the order-1 specular lobe and a cosine lobe (§13.4). It is not
 //!   the density of `sample`'s directions (which has no closed form); MIS weights built on it
-//!   keep an estimator unbiased because they still sum to one (tests/bsdf.rs checks this).
+//!   keep an estimator unbiased because they still sum to one (tests/bsdf/pdf.rs checks this).
 //!
 //! Directions point away from the surface (§0), in the local frame (`z` the macro normal),
 //! unit length; `wi` is the direction the walk enters from. Random numbers come from a caller's
@@ -34,6 +34,7 @@ use crate::normals::Normals;
 use crate::random::{exp1, open01};
 use crate::single::{g2_reflection, g2_transmission};
 use crate::smith::Smith;
+use crate::student_t::StudentT;
 use crate::walk::{EnergyPolicy, Loss, Microsurface, Observer};
 
 /// A set of scattering orders (facet interactions before the escape): the orders `k <= 64`
@@ -159,11 +160,13 @@ pub struct Sample<const C: usize> {
 /// accept the same names and ranges and report the same errors.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Description<'a> {
-    /// The NDF: `"ggx"` or `"beckmann"`.
+    /// The NDF: `"ggx"`, `"beckmann"` or `"student-t"` (§1.6).
     pub ndf: &'a str,
     /// The roughness along the tangent `x` (`alpha_u`) and `y` (`alpha_v`) axes; both finite
     /// and > 0.
     pub alpha: Roughness,
+    /// The Student-T shape `gamma` (§1.6), finite and > 3/2; ignored by the other NDFs.
+    pub gamma: f64,
     /// The facets (§4.2-4.5): `"conductor"`, `"dielectric"`, `"lambertian"` or `"hammon"`.
     pub material: &'a str,
     /// A conductor's Fresnel reflectance: `"none"` (F = 1, a lossless mirror), `"schlick"`
@@ -195,7 +198,12 @@ impl Description<'_> {
         let ndf = match self.ndf {
             "ggx" => AnyNdf::Ggx(Ggx(self.alpha)),
             "beckmann" => AnyNdf::Beckmann(Beckmann(self.alpha)),
-            other => return Err(choice("ndf", other, "\"ggx\" or \"beckmann\"")),
+            "student-t" => AnyNdf::StudentT(StudentT::new(self.alpha, self.gamma).ok_or(ParameterError {
+                field: "gamma",
+                value: self.gamma,
+                allowed: "a Student-T shape, finite and > 1.5",
+            })?),
+            other => return Err(choice("ndf", other, "\"ggx\", \"beckmann\" or \"student-t\"")),
         };
         let material = match self.material {
             "conductor" => Material::Conductor(Conductor {

@@ -25,9 +25,9 @@ def test_lossless_mirror_conductor_reflects_weight_one_exactly_in_every_lane():
     theta = np.degrees(np.arccos(rng.uniform(0.05, 1.0, n)))
     wi = np.stack([np.sin(np.radians(theta)), np.zeros(n), np.cos(np.radians(theta))], axis=1)
     alpha = rng.uniform(0.05, 1.5, n)
-    for ndf in ("ggx", "beckmann"):
+    for ndf, shape in (("ggx", {}), ("beckmann", {}), ("student-t", dict(gamma=rng.uniform(1.6, 12.0, n)))):
         wo, weight, order = bsdf.sample(
-            wi, u=rng.uniform(size=(n, 3)), seed=3, material="conductor", fresnel="none", alpha=alpha, ndf=ndf
+            wi, u=rng.uniform(size=(n, 3)), seed=3, material="conductor", fresnel="none", alpha=alpha, ndf=ndf, **shape
         )
         assert np.all(weight == 1.0)
         assert np.all(order >= 1)
@@ -157,7 +157,10 @@ def test_order_selection_splits_the_weight():
         (dict(material="conductor", alpha=np.ones(3)), ["alpha", "(3,)"]),
         (dict(material="conductor", alpha=0.5, k=np.ones((2, 2))), ["k", "(2, 2)"]),
         (dict(material="plastic", alpha=0.5), ["material", "plastic", "conductor"]),
-        (dict(material="conductor", alpha=0.5, ndf="phong"), ["ndf", "phong", "ggx"]),
+        (dict(material="conductor", alpha=0.5, ndf="phong"), ["ndf", "phong", "ggx", "student-t"]),
+        (dict(material="conductor", alpha=0.5, ndf="student-t"), ["gamma", "missing", "> 1.5"]),
+        (dict(material="conductor", alpha=0.5, ndf="student-t", gamma=np.array([3.0, 1.5])), ["gamma", "1.5", "lane 1"]),
+        (dict(material="conductor", alpha=0.5, gamma=3.0), ["gamma", "3.0", "ggx", "student-t"]),
         (dict(material="conductor", alpha=0.5, orders=[0]), ["orders", "0"]),
         (dict(material="conductor", alpha=0.5, seed=-1), ["seed", "-1"]),
         (dict(material="conductor", alpha=0.5, transport="light"), ["transport", "light"]),
@@ -168,6 +171,25 @@ def test_bad_parameters_raise_value_error_naming_field_and_value(kwargs, words):
         bsdf.sample(direction(30.0, 0.0, 2), **kwargs)
     for word in words:
         assert word in str(error.value)
+
+
+def test_student_t_at_gamma_2_evaluates_as_ggx():
+    # gamma = 2 is GGX exactly (theory §1.6): order 1 of eval is deterministic (§13.2), so the
+    # two NDFs give the same values to rounding (Lambda agrees to 1e-14, D exactly in form).
+    rng = np.random.default_rng(5)
+    n = 200
+    wi = direction(0.0, 0.0, n)
+    wi[:] = rng.normal(size=(n, 3))
+    wi[:, 2] = np.abs(wi[:, 2])
+    wi /= np.linalg.norm(wi, axis=1)[:, None]
+    wo = rng.normal(size=(n, 3))
+    wo[:, 2] = np.abs(wo[:, 2])
+    wo /= np.linalg.norm(wo, axis=1)[:, None]
+    surface = dict(material="conductor", fresnel="none", alpha_u=0.3, alpha_v=0.7, orders=1)
+    ggx = bsdf.eval(wi, wo, ndf="ggx", **surface)
+    student = bsdf.eval(wi, wo, ndf="student-t", gamma=2.0, **surface)
+    assert np.all(ggx > 0)
+    np.testing.assert_allclose(student, ggx, rtol=1e-10, atol=0)
 
 
 def test_bad_direction_shapes_raise_value_error():

@@ -128,15 +128,16 @@ def test_white_furnace_mirror_conductor_renders_one_and_mitsubas_roughconductor_
     [
         {"type": "smithwalk_dielectric", "distribution": "ggx", "alpha": 0.5, "int_ior": 1.5, "ext_ior": 1.0},
         {"type": "smithwalk_diffuse", "distribution": "beckmann", "alpha": 0.5, "reflectance": 1.0},
+        {"type": "smithwalk_conductor", "distribution": "student-t", "gamma": 3.0, "alpha": 0.6},
     ],
-    ids=["dielectric", "diffuse"],
+    ids=["dielectric", "diffuse", "student-t-mirror"],
 )
-def test_white_furnace_lossless_dielectric_and_white_diffuse_render_one(bsdf):
+def test_white_furnace_lossless_dielectric_white_diffuse_and_student_t_mirror_render_one(bsdf):
     # A dielectric sphere (int_ior 1.5, ext_ior 1, GGX alpha 0.5): reflection, refraction and
     # total internal reflection are lossless, so it renders 1 (the radiance inside is 1.5^2,
     # carried by the eta^2 factors of the radiance transport). Lambertian facets of
-    # reflectance 1 are lossless too. Same statistics as above: 616 independent pixels,
-    # 32 spp, 3 standard errors.
+    # reflectance 1 are lossless too, and so is a mirror on a Student-T surface (gamma 3).
+    # Same statistics as above: 616 independent pixels, 32 spp, 3 standard errors.
     variant("llvm_ad_rgb")
     image = render(bsdf, 32, 32, seed=2)
     mean, se = mean_and_se(image[inside_pixels(32)][:, 0])
@@ -517,7 +518,9 @@ def test_non_rgb_variants_and_bad_parameters_are_refused_in_one_line():
             smithwalk.mitsuba.register()
     variant("scalar_rgb")
     for props, words in [
-        ({"distribution": "phong"}, ["distribution", "phong"]),
+        ({"distribution": "phong"}, ["distribution", "phong", "student-t"]),
+        ({"distribution": "student-t"}, ["gamma", "missing", "> 1.5"]),
+        ({"distribution": "ggx", "gamma": 3.0}, ["gamma", "ggx", "student-t"]),
         ({"orders": "0"}, ["orders", "0"]),
         ({"orders": "two"}, ["orders", "two"]),
         ({"alpha": 0.3, "alpha_u": 0.2, "alpha_v": 0.2}, ["alpha", "alpha_u"]),

@@ -7,8 +7,8 @@
  * Furnace (docs/theory.md §13): a conductor with F = 1 (fresnel "none") absorbs nothing, and
  * with the true Smith Lambda every photon escapes, so the albedo
  * integral of f(wi, wo) |cos theta_o| dwo is 1 at every roughness and incidence. Three
- * estimators of it, per case (GGX, alpha 0.2, 0.6, 1.0; theta_i 0, 60, 85 degrees; N = 40000
- * lanes each, seeds fixed):
+ * estimators of it, per case (GGX, alpha 0.2, 0.6, 1.0; theta_i 0, 60, 85 degrees; and Student-T,
+ * gamma 1.6, alpha 0.6, the same angles: N = 40000 lanes each, seeds fixed):
  *   S: sample's weight (its mean is the albedo);
  *   E: eval(wi, wo) / q(wo) with wo uniform on the upper hemisphere, q = 1 / (2 pi)
  *      (eval's albedo, by an independent density);
@@ -18,8 +18,8 @@
  *      although pdf is not sample's density (rendering.md, "pdf");
  * and P: pdf(wo) / q(wo), whose mean is the integral of pdf over the upper hemisphere, 1.
  * Each must be 1 within Z = 4 standard errors (two-sided level 6.3e-5), and E must agree with
- * S within 4 standard errors of their difference. 9 cases x 5 checks = 45 checks: family level
- * at most 2.9e-3 (Bonferroni). sample's weight of a lossless reflection is 1 exactly, so S has
+ * S within 4 standard errors of their difference. 12 cases x 5 checks = 60 checks: family level
+ * at most 3.8e-3 (Bonferroni). sample's weight of a lossless reflection is 1 exactly, so S has
  * standard error 0 and must equal 1 to rounding (1e-12).
  *
  * Pass: exit status 0. A failure prints one line per failed check to stderr and exits 1.
@@ -86,10 +86,12 @@ static int proper(const double v[3]) {
     return 1;
 }
 
-static smithwalk_bsdf *mirror(const char *ndf, double alpha) {
+/* A lossless conductor on the NDF `ndf` (gamma: the Student-T shape, ignored by the others). */
+static smithwalk_bsdf *mirror(const char *ndf, double gamma, double alpha) {
     smithwalk_params p;
     smithwalk_params_default(&p);
     p.ndf = ndf;
+    p.gamma = gamma;
     p.alpha_u = p.alpha_v = alpha;
     smithwalk_bsdf *bsdf = NULL;
     int status = smithwalk_bsdf_new(&p, &bsdf);
@@ -98,16 +100,16 @@ static smithwalk_bsdf *mirror(const char *ndf, double alpha) {
     return bsdf;
 }
 
-static void expect_one(const char *what, double alpha, double theta_deg, const stat *s) {
+static void expect_one(const char *what, const char *ndf, double alpha, double theta_deg, const stat *s) {
     double se = std_error(s);
-    CHECK(fabs(s->mean - 1.0) <= Z * se + 1e-12, "%s, alpha %g, theta_i %g: mean %.6f, standard error %.2e",
-          what, alpha, theta_deg, s->mean, se);
-    printf("furnace %s alpha %.1f theta_i %2.0f: %.5f +- %.5f\n", what, alpha, theta_deg, s->mean, se);
+    CHECK(fabs(s->mean - 1.0) <= Z * se + 1e-12, "%s, %s alpha %g, theta_i %g: mean %.6f, standard error %.2e",
+          what, ndf, alpha, theta_deg, s->mean, se);
+    printf("furnace %s %s alpha %.1f theta_i %2.0f: %.5f +- %.5f\n", what, ndf, alpha, theta_deg, s->mean, se);
 }
 
 /* The white furnace of one case: the checks S, E, M, P described above. */
-static void furnace(double alpha, double theta_deg, uint64_t seed) {
-    smithwalk_bsdf *bsdf = mirror("ggx", alpha);
+static void furnace(const char *ndf, double gamma, double alpha, double theta_deg, uint64_t seed) {
+    smithwalk_bsdf *bsdf = mirror(ndf, gamma, alpha);
     if (!bsdf) return;
     double wi[3];
     spherical(theta_deg * PI / 180.0, 0.3, wi);
@@ -139,10 +141,10 @@ static void furnace(double alpha, double theta_deg, uint64_t seed) {
     }
     CHECK(bad == 0, "alpha %g, theta_i %g: %d lanes with an error, NaN, negative or improper output", alpha,
           theta_deg, bad);
-    expect_one("S sample weight", alpha, theta_deg, &s);
-    expect_one("E eval / uniform", alpha, theta_deg, &e);
-    expect_one("M MIS sample+uniform", alpha, theta_deg, &m);
-    expect_one("P pdf integral", alpha, theta_deg, &p);
+    expect_one("S sample weight", ndf, alpha, theta_deg, &s);
+    expect_one("E eval / uniform", ndf, alpha, theta_deg, &e);
+    expect_one("M MIS sample+uniform", ndf, alpha, theta_deg, &m);
+    expect_one("P pdf integral", ndf, alpha, theta_deg, &p);
     double se = sqrt(std_error(&s) * std_error(&s) + std_error(&e) * std_error(&e));
     CHECK(fabs(e.mean - s.mean) <= Z * se + 1e-12, "alpha %g, theta_i %g: eval's albedo %.6f, sample's %.6f", alpha,
           theta_deg, e.mean, s.mean);
@@ -218,7 +220,7 @@ static void dielectric_furnace(void) {
 /* Grazing and below-horizon directions: zeros where nothing enters or leaves, and finite,
    non-negative values everywhere (no NaN, infinity or negative number). */
 static void grazing_and_below_horizon(void) {
-    smithwalk_bsdf *bsdf = mirror("beckmann", 0.2);
+    smithwalk_bsdf *bsdf = mirror("beckmann", NAN, 0.2);
     if (!bsdf) return;
     double horizon[3] = {1.0, 0.0, 0.0}, below[3] = {0.6, 0.0, -0.8}, up[3] = {0.0, 0.0, 1.0};
     double wo[3], weight[3], value[3], lane = 0.0;
@@ -309,7 +311,9 @@ static void errors(void) {
     REFUSED(SMITHWALK_ERROR_PARAMETER, p.alpha_u = 0.0, "alpha_u", "= 0", "> 0");
     REFUSED(SMITHWALK_ERROR_PARAMETER, p.alpha_v = NAN, "alpha_v", "NaN", "finite");
     REFUSED(SMITHWALK_ERROR_PARAMETER, p.alpha_u = INFINITY, "alpha_u", "inf", "finite");
-    REFUSED(SMITHWALK_ERROR_PARAMETER, p.ndf = "phong", "ndf", "phong", "ggx", "beckmann");
+    REFUSED(SMITHWALK_ERROR_PARAMETER, p.ndf = "phong", "ndf", "phong", "ggx", "beckmann", "student-t");
+    REFUSED(SMITHWALK_ERROR_PARAMETER, p.ndf = "student-t", "gamma", "NaN", "> 1.5");
+    REFUSED(SMITHWALK_ERROR_PARAMETER, (p.ndf = "student-t", p.gamma = 1.5), "gamma", "1.5", "> 1.5");
     REFUSED(SMITHWALK_ERROR_PARAMETER, p.material = "plastic", "material", "plastic", "conductor");
     REFUSED(SMITHWALK_ERROR_PARAMETER, p.fresnel = "fancy", "fresnel", "fancy", "schlick");
     REFUSED(SMITHWALK_ERROR_PARAMETER, (p.fresnel = "schlick", p.f0[1] = 1.5), "f0", "1.5", "[0, 1]");
@@ -326,7 +330,7 @@ static void errors(void) {
           "NULL params: %s", smithwalk_last_error());
 
     /* Calls with a bad argument: an error code, zeroed outputs, a message naming it. */
-    smithwalk_bsdf *bsdf = mirror("ggx", 0.5);
+    smithwalk_bsdf *bsdf = mirror("ggx", NAN, 0.5);
     double up[3] = {0.0, 0.0, 1.0}, longer[3] = {0.0, 0.0, 2.0}, nan[3] = {NAN, 0.0, 1.0};
     double wo[3] = {7, 7, 7}, weight[3] = {7, 7, 7}, value[3] = {7, 7, 7}, lane = 0.0;
     uint32_t order = 7;
@@ -361,7 +365,7 @@ static void defaults(void) {
     memset(&p, 0xff, sizeof p);
     smithwalk_params_default(&p);
     int ok = !strcmp(p.ndf, "ggx") && !strcmp(p.material, "conductor") && !strcmp(p.fresnel, "none") &&
-             p.alpha_u == 0.5 && p.alpha_v == 0.5 && p.orders_mask == 0 && p.orders_from == 1;
+             p.alpha_u == 0.5 && p.alpha_v == 0.5 && isnan(p.gamma) && p.orders_mask == 0 && p.orders_from == 1;
     for (int c = 0; c < 3; c++) {
         ok = ok && p.eta[c] == 1.0 && p.k[c] == 0.0 && p.f0[c] == 1.0 && p.albedo[c] == 1.0;
     }
@@ -416,8 +420,9 @@ int main(void) {
     defaults();
     const double alphas[3] = {0.2, 0.6, 1.0}, thetas[3] = {0.0, 60.0, 85.0};
     for (int a = 0; a < 3; a++) {
-        for (int t = 0; t < 3; t++) furnace(alphas[a], thetas[t], 1000 + 10 * a + t);
+        for (int t = 0; t < 3; t++) furnace("ggx", NAN, alphas[a], thetas[t], 1000 + 10 * a + t);
     }
+    for (int t = 0; t < 3; t++) furnace("student-t", 3.0, 0.6, thetas[t], 2000 + t);
     orders_split_the_weight();
     dielectric_furnace();
     grazing_and_below_horizon();

@@ -6,7 +6,8 @@ Every call takes the surface as keyword arguments (see :func:`sample`); each par
 value for every lane or one per lane (a texture), and is broadcast to the N lanes of ``wi``:
 
 * ``material``: ``"conductor"``, ``"dielectric"``, ``"lambertian"`` or ``"hammon"``;
-* ``ndf``: ``"ggx"`` (default) or ``"beckmann"``;
+* ``ndf``: ``"ggx"`` (default), ``"beckmann"`` or ``"student-t"`` (theory §1.6) with its shape
+  ``gamma``: scalar or shape (N,), finite and > 1.5 (2 is GGX; large values approach Beckmann);
 * ``alpha`` (isotropic) or ``alpha_u`` and ``alpha_v`` (along the tangent x and y axes):
   scalar or shape (N,), finite and > 0;
 * ``fresnel`` (conductor): ``"none"`` (F = 1, a lossless mirror), ``"schlick"`` (from ``f0``)
@@ -48,6 +49,7 @@ from . import _native
 __all__ = ["sample", "eval", "pdf"]
 
 _MATERIALS = ("conductor", "dielectric", "lambertian", "hammon")
+_NDFS = ("ggx", "beckmann", "student-t")
 
 
 def _directions(name, value):
@@ -112,6 +114,7 @@ def _params(
     alpha=None,
     alpha_u=None,
     alpha_v=None,
+    gamma=None,
     fresnel=None,
     eta=None,
     k=None,
@@ -122,8 +125,20 @@ def _params(
     """The native call's parameters (a dict), every field broadcast to N lanes."""
     if material not in _MATERIALS:
         raise ValueError(f"`material` = {material!r} is not allowed: one of {', '.join(_MATERIALS)}")
-    if ndf not in ("ggx", "beckmann"):
-        raise ValueError(f"`ndf` = {ndf!r} is not allowed: \"ggx\" or \"beckmann\"")
+    if ndf not in _NDFS:
+        raise ValueError(f"`ndf` = {ndf!r} is not allowed: \"ggx\", \"beckmann\" or \"student-t\"")
+    if ndf == "student-t":
+        if gamma is None:
+            raise ValueError("`gamma` is missing: ndf = \"student-t\" needs its shape, finite and > 1.5")
+        g = _per_lane("gamma", gamma, n)
+        bad = ~(np.isfinite(g) & (g > 1.5))
+        if bad.any():
+            lane = int(np.argmax(bad))
+            raise ValueError(f"`gamma` = {g[lane]!r} (lane {lane}) is not allowed: a Student-T shape, finite and > 1.5")
+    elif gamma is not None:
+        raise ValueError(f"`gamma` = {gamma!r} is not allowed with ndf = {ndf!r}: only \"student-t\" has a shape")
+    else:
+        g = np.full(n, np.nan)
     if alpha is not None:
         if alpha_u is not None or alpha_v is not None:
             raise ValueError("`alpha` with `alpha_u`/`alpha_v` is not allowed: give one or the other")
@@ -153,6 +168,7 @@ def _params(
         "fresnel": fresnel,
         "ndf": ndf,
         "alpha": (au, av),
+        "gamma": g,
         "eta": eta_rgb,
         "k": _rgb("k", 0.0 if k is None else k, n),
         "f0": _rgb("f0", 1.0 if f0 is None else f0, n),

@@ -3,7 +3,8 @@
 After ``mi.set_variant(...)``, ``import smithwalk.mitsuba`` registers three BSDFs that scene
 dictionaries and XML files can name:
 
-* ``smithwalk_conductor``: ``distribution`` (``"beckmann"``, Mitsuba's default, or ``"ggx"``),
+* ``smithwalk_conductor``: ``distribution`` (``"beckmann"``, Mitsuba's default, ``"ggx"``, or
+  ``"student-t"`` with its shape ``gamma``, a number > 1.5),
   ``alpha`` or ``alpha_u``/``alpha_v`` (value or texture, default 0.1), ``material`` (a
   conductor of Mitsuba's table, e.g. ``"Au"``; ``"none"``, the default, is a perfect mirror,
   F = 1) or ``eta`` and ``k`` (values or textures);
@@ -64,10 +65,17 @@ def parse_orders(text):
 
 
 def _distribution(props):
+    """The NDF's keywords of smithwalk.bsdf: ``ndf`` and, for Student-T, ``gamma``."""
     name = props.get("distribution", "beckmann")
-    if name not in ("beckmann", "ggx"):
-        raise ValueError(f"`distribution` = {name!r} is not allowed: \"beckmann\" or \"ggx\"")
-    return name
+    if name not in ("beckmann", "ggx", "student-t"):
+        raise ValueError(f"`distribution` = {name!r} is not allowed: \"beckmann\", \"ggx\" or \"student-t\"")
+    if name != "student-t":
+        if "gamma" in props:
+            raise ValueError(f"`gamma` is not allowed with distribution = {name!r}: only \"student-t\" has a shape")
+        return {"ndf": name}
+    if "gamma" not in props:
+        raise ValueError("`gamma` is missing: distribution = \"student-t\" needs its shape, a number > 1.5")
+    return {"ndf": name, "gamma": float(props["gamma"])}
 
 
 def _roughness(props):
@@ -151,7 +159,7 @@ def register():
 
         def __init__(self, props):
             mi.BSDF.__init__(self, props)
-            self.ndf = _distribution(props)
+            self.distribution = _distribution(props)
             self.alpha_u, self.alpha_v = _roughness(props)
             self.orders = parse_orders(props.get("orders", "all"))
             self.seed = _seed(props)
@@ -174,7 +182,8 @@ def register():
 
             alpha_u = lanes(self.alpha_u, 1.0)
             alpha_v = alpha_u if self.alpha_v is self.alpha_u else lanes(self.alpha_v, 1.0)
-            keywords = dict(material=self.material, ndf=self.ndf, orders=self.orders, alpha_u=alpha_u, alpha_v=alpha_v)
+            keywords = dict(material=self.material, orders=self.orders, alpha_u=alpha_u, alpha_v=alpha_v)
+            keywords.update(self.distribution)
             keywords.update(self.material_keywords(si, active, on))
             return keywords
 
@@ -232,7 +241,8 @@ def register():
             pass
 
         def to_string(self):
-            return f"{type(self).__name__}[ndf={self.ndf}, orders={self.orders}, seed={self.seed}]"
+            ndf = ", ".join(f"{k}={v}" for k, v in self.distribution.items())
+            return f"{type(self).__name__}[{ndf}, orders={self.orders}, seed={self.seed}]"
 
         def parameters_changed(self, keys):
             pass
