@@ -217,3 +217,23 @@ fn the_azimuth_and_the_ndf_are_named_and_decades_of_roughness_get_a_log_axis() {
     let albedo = std::fs::read_to_string(out.join("albedo_vs_alpha.svg")).unwrap();
     assert!(albedo.contains("(log scale)"), "roughness from 0.01 to 1 on a linear axis");
 }
+
+/// Issue 38 point 7: a run with Student-T cases gets `albedo_vs_gamma`, the per-order albedos
+/// against `1/gamma` with its GGX (0.5) and Beckmann (0) cases on the same axis, one panel per
+/// roughness; the report shows it with its caption. (A run without Student-T has no such figure:
+/// `plot_writes_every_figure_and_a_report_that_shows_them` lists every file.)
+#[test]
+fn a_student_t_sweep_gets_an_albedo_figure_against_the_shape() {
+    let dir = tempfile::tempdir().unwrap();
+    let toml = "paths = 2000\nseed = 1\n[surface]\nndf = [\"student-t\", \"ggx\", \"beckmann\"]\ngamma = [1.6, 4]\nalpha = [0.3, 1.0]\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 30\n[detector]\ncos_theta_bins = 4\nphi_bins = 8\nmax_order = 2\n";
+    run(toml, dir.path());
+    let out = dir.path().join("figures");
+    plot(dir.path(), &PlotOptions { format: Format::Svg, out: Some(out.clone()), ..PlotOptions::default() }).unwrap();
+    let figure = std::fs::read_to_string(out.join("albedo_vs_gamma.svg")).unwrap();
+    assert!(figure.contains("1/γ (Student-T shape; Beckmann 0, GGX 0.5)"));
+    for panel in ["α = 0.3", "α = 1"] {
+        assert!(figure.contains(panel), "panel {panel}");
+    }
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(html.contains("albedo_vs_gamma.svg") && html.contains("the Student-T shape as 1/γ"));
+}

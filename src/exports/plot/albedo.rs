@@ -1,10 +1,12 @@
-//! Per-order albedos against one swept case parameter (the incident angle or the roughness):
+//! Per-order albedos against one swept case parameter (the incident angle, the roughness, or the
+//! Student-T shape):
 //! one panel per combination of the other parameters and hemisphere, one line with markers and
 //! one-standard-error bars per order slot, and one legend for the whole figure.
 
 use std::collections::{BTreeMap, BTreeSet};
 
 use anyhow::Result;
+use microsurface::ndf::AnyNdf;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -24,13 +26,23 @@ const MAX_COLUMNS: usize = 4;
 pub enum Sweep {
     Theta,
     Alpha,
+    /// The Student-T shape, drawn as `1/gamma`: the family is GGX at `gamma = 2` and tends to
+    /// Beckmann as `1/gamma` (theory §1.6), so GGX cases stand at 0.5 and Beckmann cases at 0.
+    Gamma,
 }
 
 impl Sweep {
+    pub const ALL: [Sweep; 3] = [Sweep::Theta, Sweep::Alpha, Sweep::Gamma];
+
     fn x(self, case: &Case) -> f64 {
         match self {
             Sweep::Theta => case.theta_i_deg,
             Sweep::Alpha => case.roughness().x,
+            Sweep::Gamma => match case.surface.ndf {
+                AnyNdf::StudentT(ndf) => 1.0 / ndf.gamma(),
+                AnyNdf::Ggx(_) => 0.5,
+                AnyNdf::Beckmann(_) => 0.0,
+            },
         }
     }
 
@@ -39,18 +51,27 @@ impl Sweep {
         match self {
             Sweep::Theta => vec![case_column("theta_i_deg")],
             Sweep::Alpha => vec![case_column("alpha_x"), case_column("alpha_y")],
+            Sweep::Gamma => vec![case_column("ndf"), case_column("gamma")],
         }
     }
 
-    /// Whether the case belongs on this figure: the roughness sweep takes isotropic surfaces.
+    /// Whether the case belongs on this figure: the roughness sweep takes isotropic surfaces;
+    /// the shape sweep every case, GGX and Beckmann as members of the Student-T family.
     fn takes(self, case: &Case) -> bool {
-        self == Sweep::Theta || case.roughness().x == case.roughness().y
+        self != Sweep::Alpha || case.roughness().x == case.roughness().y
+    }
+
+    /// Whether the run has the figure at all: the shape sweep needs a Student-T case (a run
+    /// of GGX and Beckmann alone is not a study of the family).
+    fn applies(self, cases: &[Case]) -> bool {
+        self != Sweep::Gamma || cases.iter().any(|c| matches!(c.surface.ndf, AnyNdf::StudentT(_)))
     }
 
     fn axis(self) -> &'static str {
         match self {
             Sweep::Theta => "incident angle θ_i (deg)",
             Sweep::Alpha => "roughness α (isotropic surfaces)",
+            Sweep::Gamma => "1/γ (Student-T shape; Beckmann 0, GGX 0.5)",
         }
     }
 
@@ -58,6 +79,7 @@ impl Sweep {
         match self {
             Sweep::Theta => "albedo_vs_theta",
             Sweep::Alpha => "albedo_vs_alpha",
+            Sweep::Gamma => "albedo_vs_gamma",
         }
     }
 }
@@ -109,6 +131,9 @@ impl<'a> AlbedoFigure<'a> {
         selection: Selection,
         rows: &'a [Row],
     ) -> Option<Self> {
+        if !sweep.applies(&run.cases) {
+            return None;
+        }
         let channel = selection.channel_name();
         let groups = groups(run.cases.iter().filter(|c| sweep.takes(c)), &sweep.columns());
         let mut group_of = vec![usize::MAX; run.cases.len()];
@@ -173,6 +198,7 @@ impl<'a> AlbedoFigure<'a> {
         let x = match self.sweep {
             Sweep::Theta => "the incident angle θ_i",
             Sweep::Alpha => "the roughness α (isotropic surfaces only)",
+            Sweep::Gamma => "the Student-T shape as 1/γ (Beckmann at 0, GGX at 0.5: the family's limit and member)",
         };
         let what = if all_orders_only(self.rows) {
             "Albedo of all bounce orders together (the fraction of the incident energy that leaves in the hemisphere)"
@@ -259,6 +285,7 @@ impl AlbedoFigure<'_> {
         let x = match self.sweep {
             Sweep::Theta => "the incident angle",
             Sweep::Alpha => "the roughness",
+            Sweep::Gamma => "the Student-T shape",
         };
         style::GridLabels {
             title: format!("Albedo {orders} against {x}{}", self.selection.suffix()),

@@ -74,7 +74,7 @@ pub fn plot(run_dir: &Path, options: &PlotOptions) -> Result<Vec<PathBuf>> {
     let ext = options.format.extension();
 
     let mut albedos = Vec::new();
-    for sweep in [albedo::Sweep::Theta, albedo::Sweep::Alpha] {
+    for sweep in albedo::Sweep::ALL {
         if let Some(figure) = albedo::AlbedoFigure::new(&run, &summary, sweep, selection, &order_rows) {
             albedos.push(Drawn {
                 name: format!("{}.{ext}", sweep.file_stem()),
