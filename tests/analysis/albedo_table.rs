@@ -189,11 +189,14 @@ fn malformed_tables_are_refused_and_nothing_is_written() {
     let avg = "quantity,side,hemisphere,order,eta,alpha,E_avg,E_avg_stderr\nR_1,outside,R,1,,0.25,0.9,0\n\
                R_1,outside,R,1,,0.75,0.6,0\n";
     let compare = |table: &std::path::Path, models: &str| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_smithwalk"))
-            .args(["compare", run.to_str().unwrap(), "--models", models, "--albedo-table"])
-            .arg(table)
-            .output()
-            .unwrap()
+        common::smithwalk(&[
+            "compare",
+            run.to_str().unwrap(),
+            "--models",
+            models,
+            "--albedo-table",
+            table.to_str().unwrap(),
+        ])
     };
     let refused = |lut: &str, avg: Option<&str>, expected: &[&str]| {
         let table = tempfile::tempdir().unwrap();
@@ -274,11 +277,14 @@ fn a_table_made_for_another_ndf_facet_or_range_is_refused() {
         table
     };
     let compare = |run: &std::path::Path, table: &std::path::Path| {
-        let output = std::process::Command::new(env!("CARGO_BIN_EXE_smithwalk"))
-            .args(["compare", run.to_str().unwrap(), "--models", "kulla-conty", "--albedo-table"])
-            .arg(table)
-            .output()
-            .unwrap();
+        let output = common::smithwalk(&[
+            "compare",
+            run.to_str().unwrap(),
+            "--models",
+            "kulla-conty",
+            "--albedo-table",
+            table.to_str().unwrap(),
+        ]);
         (
             output.status.code(),
             String::from_utf8_lossy(&output.stderr).to_string(),

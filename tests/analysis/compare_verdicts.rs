@@ -23,13 +23,8 @@ use crate::common;
 use sha2::{Digest, Sha256};
 use std::collections::HashSet;
 use std::path::Path;
-use std::process::{Command, Output};
 
-use common::CASES;
-
-fn smithwalk(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_smithwalk")).args(args).output().unwrap()
-}
+use common::{CASES, smithwalk};
 
 /// Runs `config` into `dir/name` and returns the run directory.
 fn run(dir: &Path, name: &str, config: &str) -> String {

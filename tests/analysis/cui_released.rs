@@ -61,17 +61,7 @@ fn cui2023_released_agrees_with_the_walk_and_the_exact_chain_on_conductors() {
     }
 
     // One chain of directions: the two models' lobes are equal bin by bin.
-    let status = common::smithwalk_quiet(&[
-        "compare",
-        out.to_str().unwrap(),
-        "--models",
-        "wang-correlated,exact-position-free,cui2023-released",
-        "--paths",
-        "100000",
-    ])
-    .status()
-    .unwrap();
-    assert!(status.success());
+    common::compare(&out, &["--models", "wang-correlated,exact-position-free,cui2023-released", "--paths", "100000"]);
     let mut reader = csv::Reader::from_path(out.join("models.csv")).unwrap();
     let headers = reader.headers().unwrap().clone();
     let col = |name: &str| headers.iter().position(|h| h == name).unwrap();

@@ -120,16 +120,6 @@ phi_bins = 8
 max_order = 2
 "#;
 
-/// Runs `smithwalk compare RUN --models MODELS`, returning its stdout.
-fn compare_cli(run: &std::path::Path, models: &str) -> String {
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_smithwalk"))
-        .args(["compare", run.to_str().unwrap(), "--models", models, "--threads", "2"])
-        .output()
-        .expect("the smithwalk binary runs");
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
-    String::from_utf8(output.stdout).unwrap()
-}
-
 /// `compare --models materialx,turquin` on the walk above: both are Turquin's scale of exact
 /// single scattering, and differ only by MaterialX's fit of E in place of the exact one and
 /// its `F_ss = F0 + (1 - F0)/21` in place of `F0` (the same at F = 1). Measured albedo
@@ -141,7 +131,7 @@ fn compare_cli(run: &std::path::Path, models: &str) -> String {
 fn compare_puts_materialx_within_the_fits_error_of_turquin() {
     let dir = tempfile::tempdir().unwrap();
     let (run, _) = common::run_config(dir.path(), "walk", WALK);
-    let stdout = compare_cli(&run, "materialx,turquin");
+    let stdout = common::compare(&run, &["--models", "materialx,turquin", "--threads", "2"]);
     assert!(!stdout.contains("materialx: skips"), "{stdout}");
     let mut reader = csv::Reader::from_path(run.join("compare.csv")).unwrap();
     let headers = reader.headers().unwrap().clone();
@@ -186,7 +176,7 @@ phi_bins = 8
 max_order = 2
 "#,
     );
-    let stdout = compare_cli(&run, "materialx");
+    let stdout = common::compare(&run, &["--models", "materialx", "--threads", "2"]);
     let lines: Vec<&str> = stdout.lines().filter(|l| l.contains("materialx: skips")).collect();
     assert_eq!(lines, ["  materialx: skips 3 of 4 cases: not a conductor (2), not GGX (1)"], "{stdout}");
     // Beyond alpha 1, where MaterialX clamps its roughness, and for the other reasons the

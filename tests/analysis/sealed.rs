@@ -20,10 +20,7 @@ use crate::common;
 const RUN: &str = "paths = 4000\nseed = 3\n[surface]\nalpha = [0.3, 0.7]\n[material]\nkind = \"conductor\"\n[incident]\ntheta_deg = 40\n[detector]\ncos_theta_bins = 4\nphi_bins = 8\nmax_order = 3\n";
 
 fn compare(dir: &Path, models: &str) {
-    let status = common::smithwalk_quiet(&["compare", dir.to_str().unwrap(), "--models", models, "--paths", "3000"])
-        .status()
-        .unwrap();
-    assert!(status.success(), "compare --models {models} failed");
+    common::compare(dir, &["--models", models, "--paths", "3000"]);
 }
 
 /// A copy of the run directory `from` at `to`.

@@ -39,6 +39,18 @@ pub fn smithwalk_quiet(args: &[&str]) -> std::process::Command {
     c
 }
 
+/// `smithwalk ARGS`, its exit status and output captured.
+pub fn smithwalk(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_smithwalk")).args(args).output().expect("the smithwalk binary runs")
+}
+
+/// `smithwalk compare RUN ARGS`, asserting that it succeeds; returns what it printed.
+pub fn compare(run: &std::path::Path, args: &[&str]) -> String {
+    let output = smithwalk(&[&["compare", run.to_str().unwrap()], args].concat());
+    assert!(output.status.success(), "compare {args:?}: {}", String::from_utf8_lossy(&output.stderr));
+    String::from_utf8(output.stdout).unwrap()
+}
+
 /// Writes `toml` to `dir/<name>.toml` and runs `smithwalk run` on it into `dir/<name>`,
 /// asserting that it succeeds; returns the run directory and what the run printed.
 pub fn run_config(dir: &std::path::Path, name: &str, toml: &str) -> (std::path::PathBuf, String) {
