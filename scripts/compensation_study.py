@@ -5,7 +5,7 @@
     python3 scripts/compensation_study.py out/compensation [--figures docs/figures]
 
 Reads the run's compare.csv (written by the run's [compare] section, or by
-`smithwalk compare out/compensation --models single,kulla-conty,turquin,fdez-aguera`) and
+`smithwalk compare out/compensation --models single,kulla-conty,turquin,fdez-aguera,materialx`) and
 lobes.csv, and writes
   compensation-albedo.png  albedo error (model - walk) of each model against incidence, one
                            line per roughness, with the walk's 2-standard-error bars;
@@ -25,7 +25,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
-MODELS = ["kulla-conty", "turquin", "fdez-aguera"]
+MODELS = ["kulla-conty", "turquin", "fdez-aguera", "materialx"]
 COLOURS = plt.get_cmap("viridis")
 
 
