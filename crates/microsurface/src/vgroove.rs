@@ -1,6 +1,6 @@
 //! Symmetric specular V-grooves (docs/theory.md §14): the microsurface of Lee et al. 2018
 //! ("Practical multiple scattering for rough surfaces"), a different one from the Smith height
-//! process. Every facet normal `m` of the NDF is one wall of a V-groove (a V-cavity, [H14])
+//! process. Every facet normal `m` of the NDF is one wall of a V-groove (a V-cavity of Heitz 2014)
 //! whose other wall is `m` mirrored about the macro normal in the plane of `m` and the normal;
 //! light that enters a groove bounces between its walls and leaves after a number of bounces
 //! that the groove's cross-section fixes (§14.1). A path of `k` bounces is order `k`.
