@@ -37,20 +37,41 @@ pub fn bounce_fraction(theta_i: f64, theta_s: f64, k: usize) -> f64 {
         return 0.0;
     }
     let lo = (-beta - theta_i).sin().max(0.0);
-    // Thresholds sin(psi_j) of the virtual walls the ray can reach, largest first: p in
-    // (t_{k+1}, t_k] makes k bounces.
-    let mut thresholds: Vec<f64> = (0..)
-        .map(|j| (2 * j + 1) as f64 * beta - theta_i)
-        .take_while(|&psi| psi <= PI)
-        .filter(|&psi| psi >= 0.0)
-        .map(f64::sin)
-        .collect();
-    if thresholds.len() < k {
+    // The virtual walls in [0, pi]: j from first to last. Their thresholds sin(psi_j) rise then
+    // fall, so the smallest remaining one is always at an end: popping the ends, the
+    // (count - k)-th smallest is t_{k+1} and the next one t_k (p in (t_{k+1}, t_k] makes k
+    // bounces), in O(count - k) steps and no allocation.
+    let first = ((theta_i / beta - 1.0) / 2.0).ceil().max(0.0) as i64;
+    let last = (((PI + theta_i) / beta - 1.0) / 2.0).floor() as i64;
+    let psi = |j: i64| (2 * j + 1) as f64 * beta - theta_i;
+    let (mut a, mut b) = (first, last);
+    // Guard the ends against rounding: every psi kept lies in [0, pi].
+    while a <= b && psi(a) < 0.0 {
+        a += 1;
+    }
+    while a <= b && psi(b) > PI {
+        b -= 1;
+    }
+    let count = (b - a + 1).max(0) as usize;
+    if count < k {
         return 0.0;
     }
-    thresholds.sort_by(|a, b| b.total_cmp(a));
-    let upper = thresholds[k - 1].min(width);
-    let lower = thresholds.get(k).copied().unwrap_or(f64::NEG_INFINITY).max(lo);
+    let mut pop = || {
+        let (sa, sb) = (psi(a).sin(), psi(b).sin());
+        if sa <= sb {
+            a += 1;
+            sa
+        } else {
+            b -= 1;
+            sb
+        }
+    };
+    let mut next_below = f64::NEG_INFINITY;
+    for _ in 0..count - k {
+        next_below = pop();
+    }
+    let upper = pop().min(width);
+    let lower = next_below.max(lo);
     ((upper - lower) / width).clamp(0.0, 1.0)
 }
 
@@ -101,7 +122,13 @@ pub fn order_lobe<N: Ndf>(ndf: &N, wi: DVec3, wo: DVec3, k: usize, fresnel: impl
         let c = if k % 2 == 1 { -(theta_o + theta_i) } else { theta_o - theta_i + PI };
         let c = c.rem_euclid(TAU);
         let jacobian_denominator = 2.0 * k as f64 * sum.dot(e).abs();
-        for j in 0..k {
+        // k bounces need walls steep enough for k virtual walls in [0, pi]: at most
+        // pi / (2 beta) + 1 fit, so beta <= pi / (2 (k - 1)); only the candidates
+        // 2k theta_m = c + 2 pi j between that bound and k pi are worth a look.
+        let steepest = if k > 1 { FRAC_PI_2 - PI / (2 * (k - 1)) as f64 } else { 0.0 };
+        let j_min = ((2 * k) as f64 * steepest.max(0.0) - c) / TAU;
+        let j_max = ((k as f64) * PI - c) / TAU;
+        for j in (j_min.ceil().max(0.0) as usize)..=(j_max.floor().max(0.0) as usize) {
             let theta_m = (c + TAU * j as f64) / (2 * k) as f64;
             if theta_m <= 0.0 || theta_m >= FRAC_PI_2 {
                 continue;
@@ -118,6 +145,17 @@ pub fn order_lobe<N: Ndf>(ndf: &N, wi: DVec3, wo: DVec3, k: usize, fresnel: impl
         }
     }
     total
+}
+
+/// The orders `orders` of the V-groove lobe together: the sum of [`order_lobe`] over them.
+pub fn orders_lobe<N: Ndf>(
+    ndf: &N,
+    wi: DVec3,
+    wo: DVec3,
+    orders: std::ops::RangeInclusive<usize>,
+    fresnel: impl Fn(f64) -> f64,
+) -> f64 {
+    orders.map(|k| order_lobe(ndf, wi, wo, k, &fresnel)).sum()
 }
 
 /// Where a ray from `wi` leaves the groove whose first wall is `m` after `k` bounces, with the
