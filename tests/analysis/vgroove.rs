@@ -5,7 +5,9 @@
 //! and with F = 1 all orders hold all the light. (The per-order physics is tested against a 2-D
 //! ray tracer and two quadratures in crates/microsurface/tests/walk/vgroove_oracles.rs.)
 
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::PI;
+
+use smithwalk::microsurface::DVec3;
 
 use crate::common;
 
@@ -33,33 +35,19 @@ max_order = 2
 
 /// The order-1 albedo of V-grooves on isotropic GGX `alpha` with F = 1 from `theta_i`: the
 /// Cook–Torrance lobe with the Torrance–Sparrow shadowing-masking,
-/// `∫ D(h) min(1, 2 h_z mu_i / wi·h, 2 h_z mu_o / wo·h) / (4 mu_i) dwo`, by the midpoint rule
-/// in (s, phi), `mu_o = 1 - s^2`, 400 x 800 nodes.
+/// `∫ D(h) min(1, 2 h_z mu_i / wi·h, 2 h_z mu_o / wo·h) / (4 mu_i) dwo`, GGX's D written out,
+/// by the midpoint rule in (s, phi), `mu_o = 1 - s^2`, 400 x 800 nodes.
 fn torrance_sparrow_albedo(alpha: f64, theta_i: f64) -> f64 {
-    let (si, ci) = theta_i.sin_cos();
-    let wi = [si, 0.0, ci];
-    let ggx = |h: [f64; 3]| {
-        let t2 = (h[0] * h[0] + h[1] * h[1]) / (h[2] * h[2]);
-        1.0 / (PI * alpha * alpha * h[2].powi(4) * (1.0 + t2 / (alpha * alpha)).powi(2))
+    let wi = DVec3::new(theta_i.sin(), 0.0, theta_i.cos());
+    let ggx = |h: DVec3| {
+        let t2 = (h.x * h.x + h.y * h.y) / (h.z * h.z);
+        1.0 / (PI * alpha * alpha * h.z.powi(4) * (1.0 + t2 / (alpha * alpha)).powi(2))
     };
-    let n = 400;
-    let mut sum = 0.0;
-    for i in 0..n {
-        let s = (i as f64 + 0.5) / n as f64;
-        let u = 1.0 - s * s;
-        let r = (1.0 - u * u).sqrt();
-        for j in 0..2 * n {
-            let (sp, cp) = (TAU * (j as f64 + 0.5) / (2 * n) as f64).sin_cos();
-            let wo = [r * cp, r * sp, u];
-            let sum_v = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
-            let len = (sum_v[0] * sum_v[0] + sum_v[1] * sum_v[1] + sum_v[2] * sum_v[2]).sqrt();
-            let h = sum_v.map(|x| x / len);
-            let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-            let g = (2.0 * h[2] * ci / dot(wi, h)).min(2.0 * h[2] * u / dot(wo, h)).clamp(0.0, 1.0);
-            sum += 2.0 * s * ggx(h) * g / (4.0 * ci);
-        }
-    }
-    sum * TAU / (2 * n * n) as f64
+    common::hemisphere_midpoint(400, |wo| {
+        let h = (wi + wo).normalize();
+        let g = (2.0 * h.z * wi.z / wi.dot(h)).min(2.0 * h.z * wo.z / wo.dot(h)).clamp(0.0, 1.0);
+        ggx(h) * g / (4.0 * wi.z)
+    })
 }
 
 #[test]

@@ -4,13 +4,13 @@
 //! quadratures (over outgoing directions and over groove normals) that agree only if the
 //! inverse map and its Jacobian are right; with F = 1 the orders sum to 1.
 
-use std::f64::consts::{FRAC_PI_2, TAU};
+use std::f64::consts::FRAC_PI_2;
 
 use microsurface::DVec3;
 use microsurface::ndf::{Beckmann, Ggx, Ndf, Roughness};
 use microsurface::vgroove::{bounce_fraction, leave, order_lobe};
 
-use crate::common::dir;
+use crate::common::{dir, hemisphere_midpoint};
 
 /// Traces one ray through the 2-D groove with walls tilted by `theta_s` (apex at the origin,
 /// walls of length 1), entering its opening at `x` along the in-plane direction towards the
@@ -125,23 +125,6 @@ fn order_one_is_the_torrance_sparrow_lobe() {
 /// An order-`k` lobe of one surface for a fixed `wi`: `(wo, k) -> f_k cos theta_o`.
 type Lobe<'a> = Box<dyn Fn(DVec3, usize) -> f64 + 'a>;
 
-/// Midpoint rule over the upper hemisphere in (s, phi), `cos theta = 1 - s^2`, `n x 2n` nodes:
-/// the substitution keeps the rule's error small where a lobe has its integrable `1 / sin theta`
-/// peak at the pole (order >= 2 at normal incidence, where `wi + wo` is vertical, §14.2).
-fn hemisphere(n: usize, f: impl Fn(DVec3) -> f64) -> f64 {
-    let mut sum = 0.0;
-    for i in 0..n {
-        let s = (i as f64 + 0.5) / n as f64;
-        let u = 1.0 - s * s;
-        let r = (1.0 - u * u).sqrt();
-        for j in 0..2 * n {
-            let (sp, cp) = (TAU * (j as f64 + 0.5) / (2 * n) as f64).sin_cos();
-            sum += 2.0 * s * f(DVec3::new(r * cp, r * sp, u));
-        }
-    }
-    sum * TAU / (2 * n * n) as f64
-}
-
 /// The light that enters grooves from `wi` and leaves after `k` bounces, integrated over the
 /// groove normals, for k = 1..=`orders` (index k - 1): `∫ D(m) <wi·m> g_k(m) / cos theta_i dm`,
 /// with `g_k` the cross-section's fraction in the plane of `m` (no outgoing direction, no
@@ -149,7 +132,7 @@ fn hemisphere(n: usize, f: impl Fn(DVec3) -> f64) -> f64 {
 fn over_normals<N: Ndf>(ndf: &N, wi: DVec3, orders: usize, n: usize) -> Vec<f64> {
     (0..orders)
         .map(|order| {
-            hemisphere(n, |m| {
+            hemisphere_midpoint(n, |m| {
                 let e = DVec3::new(m.x, m.y, 0.0).normalize_or_zero();
                 if e == DVec3::ZERO || wi.dot(m) <= 0.0 {
                     return 0.0;
@@ -165,7 +148,7 @@ fn over_normals<N: Ndf>(ndf: &N, wi: DVec3, orders: usize, n: usize) -> Vec<f64>
 fn each_order_carries_the_light_its_grooves_send_and_all_orders_sum_to_one() {
     // ∫ order_lobe dwo (over outgoing directions, through the inverse map and the Jacobian)
     // against the same order's light over groove normals (forward), orders 1 to 3: midpoint
-    // rules of 200 x 400 nodes (in s, phi), whose error at the lobes' kinks and at the
+    // rules of 200 x 400 nodes (in s, phi, `hemisphere_midpoint`), whose error at the lobes' kinks and at the
     // integrable peak in the mirror direction stays below 3e-3 here (against 400 x 800 nodes
     // the two sides moved by at most 1.1e-3). With F = 1 every ray that enters a groove leaves
     // it, so the orders over normals sum to 1 (orders beyond 30 carry < 4e-4 here).
@@ -183,7 +166,7 @@ fn each_order_carries_the_light_its_grooves_send_and_all_orders_sum_to_one() {
         ];
         for (name, forward, lobe) in &cases {
             for k in 1..=3 {
-                let inverse = hemisphere(200, |wo| lobe(wo, k));
+                let inverse = hemisphere_midpoint(200, |wo| lobe(wo, k));
                 println!("{name} {theta} deg order {k}: over wo {inverse:.5}, over m {:.5}", forward[k - 1]);
                 assert!(
                     (inverse - forward[k - 1]).abs() < 3e-3,
