@@ -15,7 +15,7 @@ use crate::setup::cases::Case;
 use crate::setup::config::IncidentSide;
 
 /// The highest order the model's lobes hold: a path of more bounces needs walls steeper than
-/// `pi/2 - pi/(2 * 63)` (88.6 deg, §14.2), which hold `alpha^2 / (alpha^2 + tan^2 88.6 deg)` of
+/// `pi/2 - pi/(2 * 64)` (88.6 deg, §14.2), which hold `alpha^2 / (alpha^2 + tan^2 88.6 deg)` of
 /// the light at normal incidence on GGX (6e-4 at alpha 1, 1.5e-4 at 0.5): orders beyond it are
 /// left out, the price of an evaluation that grows with the square of the orders summed.
 pub const MAX_ORDER: usize = 64;
