@@ -364,7 +364,10 @@ def main() -> None:
         "together for the models that do not separate orders), hemisphere (R the side the light came from) and "
         f"channel; lobes whose measured albedo is below {floor:g} are not scored. Which model applies to which "
         "case is `smithwalk compare`'s rule (docs/compare.md)"
-        + (f"; {', '.join(f'`{m}`' for m in absent)} applied to no case here." if absent else "."),
+        + (f"; {', '.join(f'`{m}`' for m in absent)} applied to no case here." if absent else ".")
+        + (" `lee2018` is another microsurface, specular V-grooves (docs/theory.md §14), not an approximation of "
+           "the walk's: its errors measure how far that family is from the Smith walk at each order."
+           if "lee2018" in present else ""),
         "",
         "**Albedo error**: the model's albedo minus the walk's. **Lobe error**: the relative L2 distance of the "
         "model's lobe from the walk's over the detector's bins, with the part that the Monte Carlo noise of both "

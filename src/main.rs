@@ -72,7 +72,7 @@ enum Command {
         /// The run's output directory (with run.json, lobes.csv and summary.csv).
         run_dir: PathBuf,
         /// Comma-separated models: single, hammon-fit, heitz-nee, exact-position-free,
-        /// wang-correlated, wang-uncorrelated, cui2023-released, kulla-conty, turquin, fdez-aguera, materialx.
+        /// wang-correlated, wang-uncorrelated, cui2023-released, kulla-conty, turquin, fdez-aguera, materialx, lee2018.
         #[arg(
             long,
             value_delimiter = ',',

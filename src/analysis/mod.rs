@@ -1,4 +1,4 @@
-//! Measurements against models: the analytic bin expectations ([`models`]), the comparison
+//! Measurements against models: the analytic bin expectations ([`models`], [`vgroove`]), the comparison
 //! of a run with them ([`compare`]), and the quadrature and statistics they rest on.
 
 pub mod albedo_table;
@@ -6,6 +6,7 @@ pub mod compare;
 pub mod compensation;
 pub mod external;
 pub mod models;
+pub mod vgroove;
 
 // The quadrature and statistics live in their own crate (`crates/numerics`), so that the
 // physics crate's tests use them without building this one.

@@ -11,7 +11,7 @@ use smithwalk::setup::config::Config;
 #[path = "../../crates/microsurface/tests/common/mod.rs"]
 mod physics;
 #[allow(unused_imports)] // not every test file uses them
-pub use physics::{dir, two_sided_z};
+pub use physics::{dir, hemisphere_midpoint, two_sided_z};
 
 /// Both facet kinds (a conductor, and a dielectric that transmits) at two roughnesses and two
 /// incident angles on an 8 x 16 grid, seed 11, without `paths` and `max_order` (the tests add

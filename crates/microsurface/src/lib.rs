@@ -45,7 +45,8 @@
 //! * the walk: [`walk::Microsurface::trace`] with an [`walk::Observer`] and an
 //!   [`walk::EnergyPolicy`];
 //! * the oracles: [`single`] (exact single scattering), [`nee`] (next-event estimation),
-//!   [`position_free`], [`wang`], [`cui`].
+//!   [`position_free`], [`wang`], [`cui`]; the V-groove microsurface of Lee et al. 2018:
+//!   [`vgroove`].
 //!
 //! Directions are [`DVec3`] (glam's, re-exported), pointing away from the surface (§0); a
 //! `const C: usize` parameter is the number of colour channels (1 or 3). The version policy
@@ -70,6 +71,7 @@ pub mod single;
 pub mod slope;
 pub mod smith;
 pub mod student_t;
+pub mod vgroove;
 pub mod walk;
 pub mod wang;
 

@@ -353,7 +353,7 @@ def test_help_shows_numpy_style_docstrings():
         assert needle in text, needle
     for item in (smithwalk.run, smithwalk.load, smithwalk.RunResult.compare, smithwalk.RunResult.save):
         assert "Parameters\n----------" in inspect.cleandoc(item.__doc__), item.__name__
-    assert smithwalk.MODELS[0] == "single" and len(smithwalk.MODELS) == 11
+    assert smithwalk.MODELS[0] == "single" and len(smithwalk.MODELS) == 12
 
 
 def test_the_example_runs_and_plots(tmp_path):

@@ -8,12 +8,16 @@
 //! conductors, §7.3): these four are exact for the Smith walk, so a rejection says the
 //! measurement (or the oracle) is wrong. `wang-correlated` and `wang-uncorrelated` (the Wang et
 //! al. 2022 chains) and `hammon-fit` (Hammon 2017's closed-form fit of his facet, order 1 and all
-//! orders) are approximations: their rejections measure how far they are from the walk. The
-//! Monte Carlo models run into the same detector with their own standard errors.
+//! orders) are approximations: their rejections measure how far they are from the walk.
+//! `lee2018` (Lee et al. 2018's specular V-grooves, conductors, every order slot, §14) is an
+//! approximation on another microsurface: its rejections measure how far V-grooves are from
+//! the Smith walk, order by order. The Monte Carlo models run into the same detector with their
+//! own standard errors.
 //!
 //! Like with like: the run's last order slot "K+" (`max_order = K`) holds every order from K
 //! on; a Monte Carlo model is walked with the same `max_order`, so its slots are folded exactly
 //! as the run's; `hammon-fit` folds its order-1 part into its all-orders part for a "1+" slot;
+//! `lee2018` sums its orders from K on (up to its `MAX_ORDER`) for the "K+" slot;
 //! `single`, order 1 alone, is never tested against a "1+" slot. With `max_order = 1` the "1+"
 //! slot is the all-orders lobe, which is tested once, as order 0.
 //!
@@ -48,6 +52,7 @@ use crate::analysis::external::ExternalModel;
 use crate::analysis::models::{
     MAX_BIN_EVALUATIONS, MAX_EXIT_BIN_EVALUATIONS, hammon_fit_unavailable, single_scattering_unavailable,
 };
+use crate::analysis::vgroove::lee2018_unavailable;
 use crate::atomic::write_atomically;
 use crate::io::compare_json::{self, Settings};
 use crate::io::rundir::{BinValue, LobeId, RunDir};
@@ -213,12 +218,13 @@ pub fn compare_with(run_dir: &Path, options: &CompareOptions) -> Result<Outcome>
         }
         let seed = model_seed(config.seed, model.name());
         let predictions = match model {
-            Model::Single | Model::HammonFit => {
+            Model::Single | Model::HammonFit | Model::Lee2018 => {
                 let bar = model_progress(model, terminal);
                 let p = closed_form(model, &run, &measured, &bar);
                 bar.finish_and_clear();
                 let unavailable = match model {
                     Model::Single => single_scattering_unavailable,
+                    Model::Lee2018 => lee2018_unavailable,
                     _ => hammon_fit_unavailable,
                 };
                 if let Some(note) = skipped_cases(&run.cases, unavailable) {

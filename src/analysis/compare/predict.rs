@@ -14,6 +14,7 @@ use crate::analysis::albedo_table::AlbedoTable;
 use crate::analysis::compensation::{AlbedoCache, Compensation, compensated_bins};
 use crate::analysis::external::ExternalModel;
 use crate::analysis::models::{HammonFitPart, LobeIntegrals, hammon_fit_lobe_bins, single_scattering_lobe};
+use crate::analysis::vgroove::{lee2018_lobe_bins, slot_orders};
 use crate::engine::detector::{Detector, Hemisphere};
 use crate::engine::run::{CaseResult, ChainModel, Estimator, Shard};
 use crate::engine::{RunOptions, Simulation};
@@ -52,8 +53,8 @@ pub(super) struct Predictions {
     pub(super) skipped: Option<String>,
 }
 
-/// The closed-form models' lobes: `single` (order 1) and `hammon-fit` (order 1, folded into
-/// all orders for a "1+" slot, and all orders), in every channel of the run with that
+/// The closed-form models' lobes: `single` (order 1), `hammon-fit` (order 1, folded into
+/// all orders for a "1+" slot, and all orders) and `lee2018` (every slot of the run, §14), in every channel of the run with that
 /// channel's material parameters, each bin integrated to a tolerance tied to the measured bin's
 /// standard error ([`tolerances`]). The equal channels of a material with one value per
 /// parameter in an RGB run are integrated once.
@@ -76,6 +77,12 @@ pub(super) fn closed_form(model: Model, run: &RunDir, measured: &Lobes, progress
     for case in &run.cases {
         let lobes: Vec<(usize, Hemisphere)> = match model {
             Model::Single => hemispheres(case).iter().map(|&h| (1, h)).collect(),
+            // Where the run's last slot is the folded "K+", the all-orders slot is the sum of the
+            // others (added below), which saves its integration, the dearest of all.
+            Model::Lee2018 => {
+                let first = usize::from(sums_slots(run, case.index, folded));
+                (first..run.slots[case.index]).map(|slot| (slot, Hemisphere::R)).collect()
+            }
             _ => vec![(0, Hemisphere::R), (1, Hemisphere::R)],
         };
         let shared: Vec<Vec<usize>> = if case.material_spec.is_rgb() {
@@ -94,6 +101,7 @@ pub(super) fn closed_form(model: Model, run: &RunDir, measured: &Lobes, progress
         let tolerance = |bin: usize| tolerances[bin];
         let integrals = match model {
             Model::Single => single_scattering_lobe(case, &run.grid, h, shared[0], &tolerance),
+            Model::Lee2018 => lee2018_lobe_bins(case, &run.grid, slot_orders(slot, folded), shared[0], &tolerance),
             _ => {
                 let part = if slot == 1 && folded != Some(1) { HammonFitPart::Single } else { HammonFitPart::All };
                 hammon_fit_lobe_bins(case, &run.grid, part, shared[0], &tolerance)
@@ -116,7 +124,25 @@ pub(super) fn closed_form(model: Model, run: &RunDir, measured: &Lobes, progress
             stderr: vec![0.0; run.grid.bins()],
         }));
     }
+    if model == Model::Lee2018 {
+        let mut all: Vec<ModelLobe> = Vec::new();
+        for lobe in out.lobes.iter().filter(|l| sums_slots(run, l.case, folded)) {
+            match all.iter_mut().find(|a| (a.case, a.channel) == (lobe.case, lobe.channel)) {
+                Some(a) => a.energy.iter_mut().zip(&lobe.energy).for_each(|(a, e)| *a += e),
+                None => {
+                    all.push(ModelLobe { order: 0, energy: lobe.energy.clone(), stderr: lobe.stderr.clone(), ..*lobe })
+                }
+            }
+        }
+        out.lobes.extend(all);
+    }
     out
+}
+
+/// Whether case `case`'s order slots end with the run's folded slot `folded` ("K+"), so that
+/// its all-orders slot is the sum of its other slots.
+fn sums_slots(run: &RunDir, case: usize, folded: Option<usize>) -> bool {
+    folded.is_some_and(|k| run.slots[case] == k + 1)
 }
 
 /// The note that a model skips some of the run's `cases`, with how many and why (`unavailable`

@@ -7,7 +7,7 @@ use anyhow::Result;
 
 use super::lobe::{channel_name, hemisphere_name};
 use super::predict::ModelLobe;
-use super::verdict::{LobeComparison, Verdict, is_exact_oracle, is_monte_carlo};
+use super::verdict::{LobeComparison, Verdict, is_exact_oracle, is_monte_carlo, kind};
 use crate::analysis::stats;
 use crate::engine::detector::Hemisphere;
 use crate::io::output::{bin_edges, case_fields, hemisphere_sign, hemispheres};
@@ -174,7 +174,7 @@ pub(super) fn report(
     let mut legend = Some(WORST_LOBES_LEGEND);
     let mut not_applicable: Vec<&str> = Vec::new();
     for v in verdicts {
-        let kind = if is_exact_oracle(v.model) { "exact oracle" } else { "approximation" };
+        let kind = kind(v.model);
         if let Some(reason) = &v.skipped {
             let _ = writeln!(out, "{} ({kind}): {reason}", v.model.name());
             continue;

@@ -22,6 +22,19 @@ pub fn is_exact_oracle(model: Model) -> bool {
     matches!(model, Model::Single | Model::HeitzNee | Model::ExactPositionFree | Model::CuiReleased)
 }
 
+/// What kind of model the report calls `model`: an exact oracle of the Smith walk, an
+/// approximation of it, or an approximation on another microsurface (Lee et al.'s V-grooves,
+/// docs/theory.md §14), whose distance from the walk is what its rejections measure.
+pub fn kind(model: Model) -> &'static str {
+    if is_exact_oracle(model) {
+        "exact oracle"
+    } else if model == Model::Lee2018 {
+        "approximation: V-groove microsurface, not Smith's"
+    } else {
+        "approximation"
+    }
+}
+
 /// Whether a model is estimated by a Monte Carlo walk (with its own standard errors), not
 /// integrated in closed form.
 pub fn is_monte_carlo(model: Model) -> bool {

@@ -81,6 +81,9 @@ const SKY: RGBColor = RGBColor(0x56, 0xb4, 0xe9);
 const GREY: RGBColor = RGBColor(0x77, 0x77, 0x77);
 /// Saturated blue-violet: the colour farthest from all the others in the three visions.
 const ULTRAMARINE: RGBColor = RGBColor(0x33, 0x00, 0xff);
+/// Light blue-violet: the colour farthest from all the others in the three visions once
+/// ultramarine is taken (CIE76 difference 32 or more, searched on a grid of 16 levels a channel).
+const LAVENDER: RGBColor = RGBColor(0x77, 0x66, 0xff);
 
 const fn line(colour: RGBColor, dash: Dash) -> LineStyle {
     LineStyle { colour, dash, width: 2, marker: Marker::None }
@@ -100,6 +103,7 @@ pub fn model_style(model: Model) -> LineStyle {
         Model::Turquin => line(OLIVE, Dash::Dotted),
         Model::FdezAguera => line(ROSE, Dash::Dotted),
         Model::MaterialX => line(SKY, Dash::Dashed),
+        Model::Lee2018 => line(LAVENDER, Dash::Dotted),
         Model::External => line(BROWN, Dash::LongDash),
     }
 }

@@ -22,12 +22,15 @@ pub enum Model {
     FdezAguera,
     /// MaterialX's GGX energy compensation (Turquin's form with its albedo fit), all orders.
     MaterialX,
+    /// Lee et al. 2018's symmetric specular V-grooves, conductors, per order (docs/theory.md §14):
+    /// another microsurface than Smith's.
+    Lee2018,
     /// A user's own model read from a file (`smithwalk compare --external`); not in [`Model::ALL`].
     External,
 }
 
 impl Model {
-    pub const ALL: [Model; 11] = [
+    pub const ALL: [Model; 12] = [
         Model::Single,
         Model::HammonFit,
         Model::HeitzNee,
@@ -39,6 +42,7 @@ impl Model {
         Model::Turquin,
         Model::FdezAguera,
         Model::MaterialX,
+        Model::Lee2018,
     ];
 
     pub fn name(self) -> &'static str {
@@ -54,6 +58,7 @@ impl Model {
             Model::Turquin => "turquin",
             Model::FdezAguera => "fdez-aguera",
             Model::MaterialX => "materialx",
+            Model::Lee2018 => "lee2018",
             Model::External => "external",
         }
     }
@@ -86,7 +91,7 @@ impl Model {
 #[serde(deny_unknown_fields)]
 pub struct CompareConfig {
     /// Model names: `single`, `hammon-fit`, `heitz-nee`, `exact-position-free`, `wang-correlated`,
-    /// `wang-uncorrelated`, `cui2023-released`, `kulla-conty`, `turquin`, `fdez-aguera`, `materialx`.
+    /// `wang-uncorrelated`, `cui2023-released`, `kulla-conty`, `turquin`, `fdez-aguera`, `materialx`, `lee2018`.
     pub models: Vec<String>,
     /// Photons per case for the Monte Carlo models (default: the run's `paths`).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -290,7 +290,8 @@ class RunResult:
         models : sequence of str, optional
             Model names from :data:`MODELS`: ``single``, ``hammon-fit``, ``heitz-nee``,
             ``exact-position-free``, ``wang-correlated``, ``wang-uncorrelated``,
-            ``cui2023-released``, ``kulla-conty``, ``turquin``, ``fdez-aguera``, ``materialx``. Default: all.
+            ``cui2023-released``, ``kulla-conty``, ``turquin``, ``fdez-aguera``, ``materialx``,
+            ``lee2018``. Default: all.
         paths : int, optional
             Photons per case for the Monte Carlo models (default: the run's).
         threads : int, optional
