@@ -6,9 +6,10 @@ docs/validation.md as Markdown.
 
     python compare.py lambda   --ff FF_DRIVER --sw PEER_STUDENT_T
     python compare.py vndf     --ff FF_DRIVER --sw PEER_STUDENT_T [--samples N]
-    python compare.py orders   --ff FF_DRIVER --smithwalk SMITHWALK [--paths N] [--work DIR]
+    python compare.py orders   --ff FF_DRIVER --smithwalk SMITHWALK [--paths N] [--sigma-paths N]
+                               [--jobs J] [--work DIR]
 
-Needs numpy and scipy (scripts/requirements.txt).
+Needs numpy and scipy (`pip install numpy scipy`).
 """
 import argparse
 import csv
