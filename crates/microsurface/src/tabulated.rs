@@ -275,7 +275,11 @@ impl Table {
         let nodes = |offset: f64, width: f64| -> Vec<f64> {
             (0..=QUANTILE_CELLS).map(|j| self.quantile_of(&cumulative, weight, offset + width * j as f64 / k)).collect()
         };
-        Quantiles { main: nodes(0.0, 1.0), first: nodes(0.0, 1.0 / k), last: nodes(1.0 - 1.0 / k, 1.0 / k) }
+        Quantiles {
+            main: Cells::new(nodes(0.0, 1.0)),
+            first: Cells::new(nodes(0.0, 1.0 / k)),
+            last: Cells::new(nodes(1.0 - 1.0 / k, 1.0 / k)),
+        }
     }
 
     /// theta where the law `∝ D weight` (with the nodes' `cumulative`) reaches the probability
@@ -318,66 +322,94 @@ impl Table {
         let k = QUANTILE_CELLS as f64;
         let main = (1..QUANTILE_CELLS - 1).map(|j| (j as f64 + 0.5) / k);
         let ends = (0..QUANTILE_CELLS).flat_map(|j| [(j as f64 + 0.5) / (k * k), 1.0 - (j as f64 + 0.5) / (k * k)]);
-        main.chain(ends).map(|u| (self.cdf(&cumulative, quantiles.at(u), weight) / total - u).abs()).fold(0.0, f64::max)
+        let theta = |u: f64| {
+            let (s, c) = quantiles.at(u);
+            s.atan2(c)
+        };
+        main.chain(ends).map(|u| (self.cdf(&cumulative, theta(u), weight) / total - u).abs()).fold(0.0, f64::max)
     }
 }
 
-/// theta at the quantiles of a radial law (§3.5): at `u = k / QUANTILE_CELLS`, and within the
-/// first and the last of those cells at `QUANTILE_CELLS` quantiles of their own, linear in
-/// between.
+/// The quantiles of a radial law (§3.5): at `u = k / QUANTILE_CELLS`, and within the first
+/// and the last of those cells at `QUANTILE_CELLS` quantiles of their own.
 #[derive(Debug, Default, PartialEq)]
 struct Quantiles {
-    main: Vec<f64>,
-    first: Vec<f64>,
-    last: Vec<f64>,
+    main: Cells,
+    first: Cells,
+    last: Cells,
 }
 
 impl Quantiles {
-    /// theta at the probability `u`.
+    /// `(sin theta, cos theta)` at the probability `u`.
     #[inline]
-    fn at(&self, u: f64) -> f64 {
-        let x = u * QUANTILE_CELLS as f64;
+    fn at(&self, u: f64) -> (f64, f64) {
+        let k = QUANTILE_CELLS as f64;
+        let x = u * k;
         let i = (x as usize).min(QUANTILE_CELLS - 1);
         match i {
-            0 => quantile(&self.first, x),
-            _ if i == QUANTILE_CELLS - 1 => quantile(&self.last, x - i as f64),
-            _ => self.main[i] + (x - i as f64) * (self.main[i + 1] - self.main[i]),
+            0 => self.first.point(x * k),
+            _ if i == QUANTILE_CELLS - 1 => self.last.point((x - i as f64) * k),
+            _ => self.main.point(x),
         }
     }
 
-    /// The probability below `theta`, the inverse of [`Quantiles::at`].
+    /// The probability below the angle with `(sin, cos)` `sc`, the inverse of [`Quantiles::at`].
     #[inline]
-    fn cdf(&self, theta: f64) -> f64 {
-        let i = self.main.partition_point(|&t| t <= theta);
-        if i > QUANTILE_CELLS {
-            return 1.0;
-        }
-        let cell = i - 1;
-        let within = match cell {
-            0 => quantile_cdf(&self.first, theta),
-            _ if cell == QUANTILE_CELLS - 1 => quantile_cdf(&self.last, theta),
-            _ => (theta - self.main[cell]) / (self.main[i] - self.main[cell]),
+    fn cdf(&self, sc: (f64, f64)) -> f64 {
+        let k = QUANTILE_CELLS as f64;
+        let x = self.main.position(sc);
+        let x = match x as usize {
+            0 => self.first.position(sc) / k,
+            i if i == QUANTILE_CELLS - 1 => i as f64 + self.last.position(sc) / k,
+            _ => x,
         };
-        (cell as f64 + within) / QUANTILE_CELLS as f64
+        (x / k).min(1.0)
     }
 }
 
-/// theta at the fraction `f` of a cell refined into `QUANTILE_CELLS` quantiles `nodes`.
-#[inline]
-fn quantile(nodes: &[f64], f: f64) -> f64 {
-    let x = f * QUANTILE_CELLS as f64;
-    let i = (x as usize).min(QUANTILE_CELLS - 1);
-    nodes[i] + (x - i as f64) * (nodes[i + 1] - nodes[i])
+/// `QUANTILE_CELLS` cells between `QUANTILE_CELLS + 1` quantile nodes, each node's angle
+/// stored as its `(sin, cos)`. Within a cell the normal runs along the chord between the nodes' normals,
+/// normalized (for cells of at most a few hundredths of a degree, as good as linear in theta),
+/// so that a draw needs no trigonometry.
+#[derive(Debug, Default, PartialEq)]
+struct Cells {
+    sin_cos: Vec<(f64, f64)>,
 }
 
-/// The fraction of a refined cell's probability below `theta`, the inverse of [`quantile`].
-#[inline]
-fn quantile_cdf(nodes: &[f64], theta: f64) -> f64 {
-    let i = nodes.partition_point(|&t| t <= theta);
-    if i > QUANTILE_CELLS {
-        return 1.0;
+impl Cells {
+    fn new(theta: Vec<f64>) -> Self {
+        Cells { sin_cos: theta.iter().map(|t| t.sin_cos()).collect() }
     }
-    ((i - 1) as f64 + (theta - nodes[i - 1]) / (nodes[i] - nodes[i - 1])) / QUANTILE_CELLS as f64
+
+    /// `(sin theta, cos theta)` at the position `x` in `[0, QUANTILE_CELLS)`: in cell
+    /// `floor(x)`, at the fraction `x - floor(x)` of its chord.
+    #[inline]
+    fn point(&self, x: f64) -> (f64, f64) {
+        let i = (x as usize).min(QUANTILE_CELLS - 1);
+        let f = x - i as f64;
+        let ((s0, c0), (s1, c1)) = (self.sin_cos[i], self.sin_cos[i + 1]);
+        let (s, c) = (s0 + f * (s1 - s0), c0 + f * (c1 - c0));
+        let norm = (s * s + c * c).sqrt();
+        (s / norm, c / norm)
+    }
+
+    /// The position of the angle with `(sin, cos)` `(s, c)`, the inverse of [`Cells::point`]:
+    /// on the chord between the normals of angles `theta_0` and `theta_1`, the point at the
+    /// fraction `f` has the angle `theta` with
+    /// `f = sin(theta - theta_0) / (sin(theta - theta_0) + sin(theta_1 - theta))`, each sine a
+    /// cross product of the two `(sin, cos)`: no trigonometry. `QUANTILE_CELLS` beyond the last
+    /// node.
+    #[inline]
+    fn position(&self, (s, c): (f64, f64)) -> f64 {
+        // sin(theta - theta_node) >= 0: the node is at or below the angle.
+        let i = self.sin_cos.partition_point(|&(sn, cn)| s * cn - c * sn >= 0.0);
+        if i > QUANTILE_CELLS {
+            return QUANTILE_CELLS as f64;
+        }
+        let ((s0, c0), (s1, c1)) = (self.sin_cos[i - 1], self.sin_cos[i]);
+        let (after, before) = (s * c0 - c * s0, s1 * c - c1 * s);
+        (i - 1) as f64 + after / (after + before)
+    }
 }
 
 impl Ndf for Tabulated {
@@ -418,8 +450,7 @@ impl Ndf for Tabulated {
         let c = w.z;
         // A normal of polar angle theta at azimuth psi from w's with density ∝ cos psi on
         // |psi| < pi/2 (sin psi uniform): the facets that lean towards w.
-        let leaning = |theta: f64, rng: &mut R| {
-            let (st, ct) = theta.sin_cos();
+        let leaning = |(st, ct): (f64, f64), rng: &mut R| {
             let v = 2.0 * open01(rng) - 1.0;
             DVec3::new(st * (1.0 - v * v).sqrt(), st * v, ct)
         };
@@ -431,7 +462,7 @@ impl Ndf for Tabulated {
                 if open01(rng) >= p_first {
                     break leaning(table.mean_quantiles.at(open01(rng)), rng);
                 }
-                let (st, ct) = table.area_quantiles.at(open01(rng)).sin_cos();
+                let (st, ct) = table.area_quantiles.at(open01(rng));
                 let (cp, sp) = azimuth(rng);
                 let m = DVec3::new(st * cp, st * sp, ct);
                 // Kept with (w·m)_+ / (c m_z): always where the facet leans towards w.
@@ -442,7 +473,8 @@ impl Ndf for Tabulated {
         } else {
             // Below the horizon only slopes r > a = |c| / s face w: the leaning facets of those
             // radii, kept with (w·m)_+ / (s m_x) = (t - a) / t in the slope t = r cos psi.
-            let u0 = table.mean_quantiles.cdf((-c).atan2(s));
+            // tan theta_a = a = |c| / s, and (s, c) is a unit vector.
+            let u0 = table.mean_quantiles.cdf((-c, s));
             if u0 >= 1.0 {
                 return DVec3::Z;
             }
@@ -459,11 +491,14 @@ impl Ndf for Tabulated {
 
     /// The slope radius at the quantile `u` of `D(m) m_z` (Hammon's sampler, §3.3).
     fn std_slope_radius(&self, u: f64) -> f64 {
-        self.table.area_quantiles.at(u).tan()
+        let (s, c) = self.table.area_quantiles.at(u);
+        s / c
     }
 
     fn std_slope_cdf(&self, r: f64) -> f64 {
-        self.table.area_quantiles.cdf(r.atan())
+        let norm = r.hypot(1.0);
+        let sc = if norm.is_finite() { (r / norm, 1.0 / norm) } else { (1.0, 0.0) };
+        self.table.area_quantiles.cdf(sc)
     }
 }
 
