@@ -24,8 +24,8 @@ use crate::random::{azimuth, open01};
 pub use input::{HEADER, MAX_STEP_DEG, MIN_ROWS, TableError};
 
 /// The step in theta_m (degrees) the docs recommend (docs/theory.md §1.7): 361 rows from 0 to 90
-/// degrees. Tables of GGX and Student-T at this step reproduce their Lambda within a relative
-/// 3e-5 for roughness 0.5 to 2 and 4e-4 at roughness 0.1.
+/// degrees. Tables of GGX (roughness 0.1 to 2) and Student-T (gamma 3) at this step reproduce
+/// their Lambda within 2.2e-5 (1 + |Lambda|) over the whole sphere.
 pub const RECOMMENDED_STEP_DEG: f64 = 0.25;
 
 /// Intervals of the table of `T(mu) = E[(X - mu)_+]` over `u = sin theta / (sin theta + |cos theta|)`
