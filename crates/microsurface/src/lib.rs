@@ -8,6 +8,8 @@
 //!   and exact full-sphere visible-normal sampling;
 //! * [`student_t`]: the Student-T NDF, between GGX and Beckmann, with its exact `Lambda` and
 //!   visible-normal sampler;
+//! * [`tabulated`]: an isotropic NDF read from a table of D(theta_m), with Lambda and
+//!   visible-normal sampling tabulated to stated errors;
 //! * [`smith`]: which `Lambda` drives the height process (true full-sphere Smith or Hammon's
 //!   symmetric variant);
 //! * [`height`]: the height process as free flights in optical depth;
@@ -37,7 +39,8 @@
 //! users are meant to build on are:
 //!
 //! * the surface: [`ndf::Ndf`] (the trait every NDF implements), [`ndf::Ggx`],
-//!   [`ndf::Beckmann`], [`student_t::StudentT`], [`ndf::Roughness`], and [`ndf::AnyNdf`] (an NDF chosen at run time);
+//!   [`ndf::Beckmann`], [`student_t::StudentT`], [`tabulated::Tabulated`], [`ndf::Roughness`], and
+//!   [`ndf::AnyNdf`] (an NDF chosen at run time);
 //!   [`smith::Smith`], [`normals::Normals`], and [`walk::Microsurface`], which composes them;
 //! * the facets: [`facet::Facet`] (the trait every micro-BSDF implements), [`facet::Conductor`]
 //!   with its [`facet::ConductorFresnel`], [`facet::Dielectric`], [`facet::Lambertian`],
@@ -71,6 +74,7 @@ pub mod single;
 pub mod slope;
 pub mod smith;
 pub mod student_t;
+pub mod tabulated;
 pub mod vgroove;
 pub mod walk;
 pub mod wang;

@@ -32,3 +32,12 @@ pub fn hemisphere_midpoint(n: usize, mut f: impl FnMut(DVec3) -> f64) -> f64 {
     }
     sum * std::f64::consts::TAU / (2 * n * n) as f64
 }
+
+/// The table of an isotropic NDF's D(theta_m) at angles `step_deg` apart from 0 to 90 degrees,
+/// multiplied by `factor` (a table may be in any unit), as a tabulated NDF.
+pub fn table_of<N: microsurface::ndf::Ndf>(ndf: &N, step_deg: f64, factor: f64) -> microsurface::tabulated::Tabulated {
+    let n = (90.0 / step_deg).round() as usize;
+    let theta: Vec<f64> = (0..=n).map(|i| 90.0 * i as f64 / n as f64).collect();
+    let d: Vec<f64> = theta.iter().map(|&t| factor * ndf.d(dir(t, 0.0))).collect();
+    microsurface::tabulated::Tabulated::new(&theta, &d).expect("a table of an analytic NDF")
+}

@@ -9,4 +9,5 @@ mod height_process;
 mod identities;
 mod phase_normalization;
 mod slope_space;
+mod tabulated;
 mod visible_normals;
