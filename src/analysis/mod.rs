@@ -6,6 +6,7 @@ pub mod compare;
 pub mod compensation;
 pub mod external;
 pub mod models;
+mod visible;
 
 // The quadrature and statistics live in their own crate (`crates/numerics`), so that the
 // physics crate's tests use them without building this one.
