@@ -7,6 +7,7 @@ pub mod compensation;
 pub mod external;
 pub mod models;
 pub mod vgroove;
+mod visible;
 
 // The quadrature and statistics live in their own crate (`crates/numerics`), so that the
 // physics crate's tests use them without building this one.

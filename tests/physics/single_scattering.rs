@@ -15,6 +15,8 @@
 //!   every channel's order-1 histogram against the model of that channel, and the conductors'
 //!   order-1 albedos against the integral over the visible normals; channel r's model is
 //!   rejected on g and b.
+//! * Student-T (§1.6): conductor, dielectric R and T, Lambertian and Hammon facets, gamma 1.6
+//!   and 3, one anisotropic, by the same chi-square and z tests.
 //! * The model itself: on nearly smooth surfaces its bins' sum against the order-1 albedo
 //!   integrated over the visible normals instead of the outgoing directions, and it is offered
 //!   only for the walk it describes (true Smith Lambda, visible normals, light from outside).
@@ -225,6 +227,40 @@ fn order_one_of_scattering_facets_matches_single_scattering() {
         let label = format!("{material} {alpha} at {theta} deg");
         assert_cells_and_albedo(albedo(d, 1, Hemisphere::R), &test, &expected, level, &label);
         assert!(test.p_value > level, "{material} {alpha} at {theta} deg: order 1 rejected\n{}", test.worst_cells(10));
+    }
+}
+
+#[test]
+fn order_one_of_student_t_walks_matches_single_scattering() {
+    // The Student-T NDF (§1.6) for every facet material: conductor, dielectric reflection and
+    // transmission, Lambertian and Hammon facets, gamma 1.6 (tails near the limit 3/2) and 3,
+    // one anisotropic; the diffuse parts by the Student-T visible-normal rule. 10^6 photons,
+    // 16 x 32 bins (8 x 16 for the diffuse facets), cells with expected count < 5 pooled, at
+    // least 16 cells left, and the order-1 albedo against the bins' sum by a z test; Sidak
+    // family level 0.01 over the 10 tests.
+    let cases = [
+        ("gamma = 1.6\nalpha = 0.5", "kind = \"conductor\"", 30.0, &[Hemisphere::R][..], 16),
+        ("gamma = 3\nalpha = 0.4", "kind = \"dielectric\"\neta = 1.5", 60.0, &[Hemisphere::R, Hemisphere::T][..], 16),
+        ("gamma = 1.6\nalpha = [[0.8, 0.3]]", "kind = \"diffuse\"\nalbedo = 0.9", 70.0, &[Hemisphere::R][..], 8),
+        ("gamma = 3\nalpha = 0.6", "kind = \"hammon\"\nf0 = 0.04\nalbedo = 0.75", 45.0, &[Hemisphere::R][..], 8),
+    ];
+    let level = sidak(0.01, 2 * 5);
+    for (i, (surface, material, theta, hemispheres, cos_bins)) in cases.into_iter().enumerate() {
+        let toml = format!(
+            "paths = 1_000_000\nseed = {}\n[surface]\nndf = \"student-t\"\n{surface}\n[material]\n{material}\n[incident]\ntheta_deg = {theta}\nphi_deg = 25\n[detector]\ncos_theta_bins = {cos_bins}\nphi_bins = {}\nmax_order = 2\n",
+            170 + i,
+            2 * cos_bins
+        );
+        let sim = simulate(&toml, 2);
+        let d = mono(&sim, 0);
+        for &h in hemispheres {
+            let expected = single_scattering_bins(&sim.cases[0], &d.grid, h, 0, 1e-9).expect("true Smith");
+            let test = chi_square(&weighted_bins(d, 1, h), &expected, d.tallies.photons, 5.0);
+            let label = format!("{surface} {material} at {theta} deg {h:?}").replace('\n', " ");
+            println!("{label}: chi2 {:.1}, dof {}, p {:.3e}", test.statistic, test.dof, test.p_value);
+            assert_cells_and_albedo(albedo(d, 1, h), &test, &expected, level, &label);
+            assert!(test.p_value > level, "{label}: order 1 rejected\n{}", test.worst_cells(10));
+        }
     }
 }
 

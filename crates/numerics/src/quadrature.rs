@@ -334,6 +334,32 @@ pub fn gauss_legendre(n: usize, a: f64, b: f64) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// Tanh–sinh (double exponential) nodes and weights on [a, b] with step `h` (Takahasi & Mori
+/// 1974): `x = tanh(pi/2 sinh(k h))` for every integer `k` whose weight
+/// `h pi/2 cosh(k h) / cosh^2(pi/2 sinh(k h))` is at least `1e-20` of the central one. The
+/// nodes crowd double-exponentially towards the ends, so that integrable algebraic endpoint
+/// singularities of bounded or mildly singular integrands (`x^p`, `(b - x)^p`, `p >= -1/2`)
+/// cost no accuracy: the error falls like `e^{-c/h}`. The distance of a node to its nearer end is computed as `1 / (1 + e^{2u})`, not
+/// as a difference, so that nodes a rounding error from an end stay distinct from it.
+pub fn tanh_sinh(h: f64, a: f64, b: f64) -> Vec<(f64, f64)> {
+    let half = std::f64::consts::FRAC_PI_2;
+    let weight = |t: f64| h * half * t.cosh() / (half * t.sinh()).cosh().powi(2);
+    let floor = 1e-20 * weight(0.0);
+    let mut rule = vec![(0.5 * (a + b), (b - a) * 0.5 * weight(0.0))];
+    for k in 1.. {
+        let t = k as f64 * h;
+        let w = weight(t);
+        if w < floor {
+            break;
+        }
+        // 1 - tanh(u) = 2 / (1 + e^{2u}).
+        let gap = (b - a) / (1.0 + (2.0 * half * t.sinh()).exp());
+        rule.push((a + gap, 0.5 * (b - a) * w));
+        rule.push((b - gap, 0.5 * (b - a) * w));
+    }
+    rule
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -410,5 +436,18 @@ mod tests {
         let (v, _) = integrate_2d(|x, y| (-x * x - y * y).exp(), (-5.0, 5.0), (-5.0, 5.0), 1e-12);
         let e5 = statrs::function::erf::erf(5.0);
         assert!((v - std::f64::consts::PI * e5 * e5).abs() < 1e-9, "{v}");
+    }
+
+    #[test]
+    fn tanh_sinh_takes_endpoint_singularities() {
+        // ∫_0^1 x^-0.5 = 2, ∫_0^1 x^(1/17) (1 - x)^1.5 = B(18/17, 5/2), ∫_0^2 x^2 = 8/3: the
+        // algebraic singularities at either end cost nothing at h = 1/8 (55 nodes). (Stronger
+        // ones, x^-0.8, lose 3e-4 to the truncation of the weights at 1e-20.)
+        let rule = |f: &dyn Fn(f64) -> f64, a, b| tanh_sinh(0.125, a, b).iter().map(|&(x, w)| w * f(x)).sum::<f64>();
+        assert!((rule(&|x| x.powf(-0.5), 0.0, 1.0) - 2.0).abs() < 1e-9);
+        let beta = statrs::function::beta::beta(18.0 / 17.0, 2.5);
+        assert!((rule(&|x| x.powf(1.0 / 17.0) * (1.0 - x).powf(1.5), 0.0, 1.0) - beta).abs() < 1e-12 * beta);
+        assert!((rule(&|x| x * x, 0.0, 2.0) - 8.0 / 3.0).abs() < 1e-13);
+        assert_eq!(tanh_sinh(0.125, 0.0, 1.0).len(), 55);
     }
 }
