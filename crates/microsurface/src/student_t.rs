@@ -31,6 +31,9 @@ pub struct StudentT {
     mixing: Gamma<f64>,
     /// The mixing law weighted by the scale `s_G = sqrt((gamma-1) / G)`, `Gamma(gamma - 3/2, 1)`.
     scaled_mixing: Gamma<f64>,
+    /// The mixing law weighted by `s_G^3`, `Gamma(gamma - 5/2, 1)`, for the proposal below the
+    /// horizon near the nadir (§3.4); it exists for `gamma > 5/2`, and is used only above 3.
+    nadir_mixing: Option<Gamma<f64>>,
 }
 
 impl StudentT {
@@ -52,6 +55,7 @@ impl StudentT {
             mean_scale,
             mixing: Gamma::new(gamma - 1.0, 1.0).ok()?,
             scaled_mixing: Gamma::new(gamma - 1.5, 1.0).ok()?,
+            nadir_mixing: Gamma::new(gamma - 2.5, 1.0).ok(),
         })
     }
 
@@ -114,11 +118,20 @@ impl StudentT {
         w.z / self.roughness.tangential2(w).sqrt()
     }
 
-    /// The roughness-1 slope along the view azimuth of a direction with `mu = cot theta'`
-    /// (stretched, §3.1) and the scale `s_G` of the Beckmann component it was drawn in: the
-    /// pair is distributed as the visible slopes of the scale mixture (§3.4), so that the
-    /// orthogonal slope is that component's normal of variance `s_G^2 / 2`.
-    fn visible_slope<R: Rng + ?Sized>(&self, mu: f64, rng: &mut R) -> (f64, f64) {
+    /// The roughness-1 slopes of a visible normal as `(x, s, z)`, all divided by one factor
+    /// `f >= 1` so that none overflows: `x / z` is the slope along the view azimuth of a
+    /// direction with `mu = cot theta'` (stretched, §3.1) and `s / z` the scale `s_G` of the
+    /// Beckmann component it was drawn in. The pair is distributed as the visible slopes of the
+    /// scale mixture (§3.4), so that the orthogonal slope is that component's normal of
+    /// variance `s_G^2 / 2`.
+    ///
+    /// Each branch is a rejection loop whose acceptance is at least 1/4 for every `gamma > 3/2`
+    /// and every `mu` (§3.4, by quadrature; 1/4 is reached at the nadir at `gamma = 3`), so
+    /// at most 4 passes on average and a sample costs O(1) up to the nadir at any shape.
+    /// Measured (`cargo test --release -p smithwalk-microsurface --test distributions
+    /// near_the_nadir -- --nocapture`, 10^4 normals 1e-3 to 1e-300 rad from the nadir): 6.1
+    /// random words a normal at `gamma` 1e6 and 1e3, 20.7 at 3.2, 7.2 at 1.6.
+    fn visible_slope<R: Rng + ?Sized>(&self, mu: f64, rng: &mut R) -> (f64, f64, f64) {
         let scale = |g: f64| ((self.gamma - 1.0) / g).sqrt();
         if mu >= 0.0 {
             // (mu - x)_+ <= mu + (-x)_+: the component of mass mu draws G from the mixing law
@@ -129,33 +142,48 @@ impl StudentT {
             loop {
                 if open01(rng) >= p_first {
                     let s = scale(self.scaled_mixing.sample(rng));
-                    return (-s * exp1(rng).sqrt(), s);
+                    return (-s * exp1(rng).sqrt(), s, 1.0);
                 }
                 let s = scale(self.mixing.sample(rng));
                 let x = s * std_beckmann_slope(rng);
                 if x <= 0.0 || open01(rng) < 1.0 - x / mu {
-                    return (x, s);
+                    return (x, s, 1.0);
                 }
             }
         }
-        // Below the horizon, t = -x > a = -mu: the proposal t e^{-t^2/s^2} on t > a has mass
-        // s e^{-a^2/s^2} / (2 sqrt(pi)) given G, so G is drawn from the mixing law weighted by
-        // it, Gamma(gamma - 3/2, 1 + a^2 / (gamma-1)); then t = sqrt(a^2 + s^2 E), kept with
-        // (t - a) / t. Written in a_G^2 = a^2 / s^2 = g k, with g the Gamma(gamma - 3/2, 1)
-        // draw and k = a^2 / (gamma - 1 + a^2), so that nothing squares `a`: near the nadir
-        // `a` reaches 1e154 and more, where a^2 overflows (the rate was then infinite and no
-        // draw was ever kept).
+        // Below the horizon, t = -x > a = -mu. Both proposals are written in a_G = a / s_G,
+        // a_G^2 = g k with k = a^2 / (gamma - 1 + a^2) and g a Gamma draw, so that nothing
+        // squares `a` (near the nadir it reaches 1e154 and more, where a^2 overflows), and
+        // return t / a (`stretch`) and s_G / a = 1 / a_G.
         let a = -mu;
         let inv = 1.0 / a;
         let k = 1.0 / (1.0 + (self.gamma - 1.0) * inv * inv);
-        loop {
-            let a_g = (self.scaled_mixing.sample(rng) * k).sqrt();
-            let stretch = (1.0 + exp1(rng) / (a_g * a_g)).sqrt();
-            // (t - a) / t = 1 - 1 / stretch with t = a stretch.
-            if open01(rng) * stretch < stretch - 1.0 {
-                return (-a * stretch, a / a_g);
-            }
-        }
+        let (stretch, inv_a_g) = match self.nadir_mixing {
+            // Near the nadir (§3.4): in s = t/s_G - a_G the target is Gamma(gamma - 5/2, 1) in
+            // g times Gamma(2, 2 a_G) in s times e^{-s^2}, Beckmann's large-a proposal (§3.2)
+            // with G drawn jointly: s = (E1 + E2) / (2 a_G), kept when E3 > s^2.
+            Some(nadir) if (self.gamma - 2.5) * k > 0.5 => loop {
+                let a_g = (nadir.sample(rng) * k).sqrt();
+                let s = (exp1(rng) + exp1(rng)) / (2.0 * a_g);
+                if exp1(rng) > s * s {
+                    break (1.0 + s / a_g, 1.0 / a_g);
+                }
+            },
+            // Elsewhere the proposal t e^{-t^2/s^2} on t > a, of mass s e^{-a^2/s^2} / (2 sqrt(pi))
+            // given G, so G from the mixing law weighted by it, g ~ Gamma(gamma - 3/2, 1); then
+            // t = sqrt(a^2 + s^2 E), kept with (t - a) / t = 1 - 1 / stretch.
+            _ => loop {
+                let a_g = (self.scaled_mixing.sample(rng) * k).sqrt();
+                let stretch = (1.0 + exp1(rng) / (a_g * a_g)).sqrt();
+                if open01(rng) * stretch < stretch - 1.0 {
+                    break (stretch, 1.0 / a_g);
+                }
+            },
+        };
+        // Slopes a stretch and a / a_G, which overflow near the nadir at small G, divided by
+        // max(a, 1).
+        let (a_f, z) = if a > 1.0 { (1.0, inv) } else { (a, 1.0) };
+        (-a_f * stretch, a_f * inv_a_g, z)
     }
 }
 
@@ -214,14 +242,14 @@ impl Ndf for StudentT {
         } else {
             return DVec3::Z;
         };
-        let (x, s) = self.visible_slope(mu, rng);
+        let (x, s, z) = self.visible_slope(mu, rng);
         let y = s * std_beckmann_slope(rng);
-        // Slopes near the nadir reach 1e154 and more: scaled before squaring (normalize).
-        let c = x.abs().max(y.abs()).max(1.0);
+        // Slopes near the nadir reach 1e154 and more (times z): scaled before squaring (normalize).
+        let c = x.abs().max(y.abs()).max(z);
         let (x, y) = (x / c, y / c);
         let sx = cos_phi * x - sin_phi * y;
         let sy = sin_phi * x + cos_phi * y;
-        DVec3::new(-self.roughness.x * sx, -self.roughness.y * sy, 1.0 / c).normalize()
+        DVec3::new(-self.roughness.x * sx, -self.roughness.y * sy, z / c).normalize()
     }
 
     /// The slope radius of `D(m) m_z` has `P(r' > r) = (1 + r^2/(gamma-1))^{-(gamma-1)}`, so
