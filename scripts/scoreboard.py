@@ -283,7 +283,9 @@ def figure(scored: pd.DataFrame, models: list[str], axis: str, label: str, path:
                 if g.empty:
                     continue
                 curve = g.assign(v=g[column].abs()).groupby(axis)["v"].median()
-                ax.plot(curve.index, curve.clip(lower=1e-5), marker="o", ms=3, color=colours(k % 10), label=model)
+                # Ten colours, then the same colours dashed with other markers: no two models alike.
+                style = dict(color=colours(k % 10), ls="-" if k < 10 else "--", marker="os^DvP<>Xh"[k // 10 % 10])
+                ax.plot(curve.index, curve.clip(lower=1e-5), ms=3, label=model, **style)
             ax.set_yscale("log")
             ax.set_ylim(1e-5, 2.0)
             if i == 0:
