@@ -183,6 +183,19 @@ fn beckmann_lambda_above(a: f64) -> f64 {
     (0.5 * ((-a * a).exp() / (a * SQRT_PI) - erfc(a))).max(0.0)
 }
 
+/// Lambda on the whole sphere (§1.4) of an NDF whose Lambda above the horizon is a function
+/// `above(a)` of `a = w_z / |A_t w|` alone (Beckmann, Student-T): NaN where `a` is (a zero or
+/// NaN direction), `±inf` on the horizon from either side, and `-1 - Lambda(-w)` below it.
+pub(crate) fn lambda_from_above(w: DVec3, a: f64, above: impl FnOnce(f64) -> f64) -> f64 {
+    if a.is_nan() {
+        return f64::NAN;
+    }
+    if w.z == 0.0 {
+        return if w.z.is_sign_positive() { f64::INFINITY } else { f64::NEG_INFINITY };
+    }
+    if a > 0.0 { above(a) } else { -1.0 - above(-a) }
+}
+
 impl Beckmann {
     /// `a = w_z / sqrt(alpha_x^2 w_x^2 + alpha_y^2 w_y^2)` (§1.4), `±inf` at the poles.
     fn a(&self, w: DVec3) -> f64 {
@@ -206,14 +219,7 @@ impl Ndf for Beckmann {
     }
 
     fn lambda(&self, w: DVec3) -> f64 {
-        let a = self.a(w);
-        if a.is_nan() {
-            return f64::NAN;
-        }
-        if w.z == 0.0 {
-            return if w.z.is_sign_positive() { f64::INFINITY } else { f64::NEG_INFINITY };
-        }
-        if a > 0.0 { beckmann_lambda_above(a) } else { -1.0 - beckmann_lambda_above(-a) }
+        lambda_from_above(w, self.a(w), beckmann_lambda_above)
     }
 
     /// `A = (1 + Lambda(w)) w_z` above the horizon and `Lambda(-w) |w_z|` below (§1.5, §10).

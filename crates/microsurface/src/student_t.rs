@@ -10,7 +10,7 @@ use rand::Rng;
 use rand_distr::{Distribution, Gamma};
 
 use crate::beta::{ln_beta, regularized_incomplete_beta};
-use crate::ndf::{Ndf, Roughness, SQRT_PI, std_beckmann_slope};
+use crate::ndf::{Ndf, Roughness, SQRT_PI, lambda_from_above, std_beckmann_slope};
 use crate::random::{exp1, open01};
 
 /// Anisotropic Student-T with roughness (alpha_x, alpha_y) and shape `gamma > 3/2` (§1.6).
@@ -206,15 +206,7 @@ impl Ndf for StudentT {
 
     /// `Lambda = E[(X - a)_+] / a` (§1.4, §1.6) above the horizon, `-1 - Lambda(-w)` below.
     fn lambda(&self, w: DVec3) -> f64 {
-        let a = self.a(w);
-        if a.is_nan() {
-            return f64::NAN;
-        }
-        if w.z == 0.0 {
-            return if w.z.is_sign_positive() { f64::INFINITY } else { f64::NEG_INFINITY };
-        }
-        let above = self.tail_mean(a.abs()) / a.abs();
-        if a > 0.0 { above } else { -1.0 - above }
+        lambda_from_above(w, self.a(w), |a| self.tail_mean(a) / a)
     }
 
     /// `A = max(w_z, 0) + |A_t w| E[(X - |a|)_+]` on the whole sphere (§1.5, §1.6): the
